@@ -1,9 +1,41 @@
-"""tumble: rigid-body physics for Python."""
+"""tumble: rigid-body physics for Python.
+
+    >>> import tumble
+    >>> world = tumble.World()
+    >>> ball = world.add_body(tumble.Sphere(0.1), density=1000.0, position=(0.0, 0.0, 1.0))
+    >>> world.step(0.01)
+    >>> round(float(ball.velocity[2]), 4)
+    -0.0981
+"""
 
 from __future__ import annotations
 
 __version__ = "0.1.0"
 
+from . import mass, rotation
 from .errors import SimulationError
+from .handles import Body
+from .mass import MassProperties
+from .shapes import Box, Capsule, ConvexHull, Cylinder, Plane, Shape, ShapeType, Sphere, TriMesh
+from .trajectory import Trajectory
+from .world import World
 
-__all__ = ["SimulationError", "__version__"]
+__all__ = [
+    "Body",
+    "Box",
+    "Capsule",
+    "ConvexHull",
+    "Cylinder",
+    "MassProperties",
+    "Plane",
+    "Shape",
+    "ShapeType",
+    "SimulationError",
+    "Sphere",
+    "Trajectory",
+    "TriMesh",
+    "World",
+    "__version__",
+    "mass",
+    "rotation",
+]

@@ -6,6 +6,7 @@ these functions first. Nothing is silently clipped: a value is accepted as given
 
 from __future__ import annotations
 
+import math
 import numbers
 
 import numpy as np
@@ -27,6 +28,8 @@ def _show(value) -> str:
 
 def as_float(name: str, value, *, positive: bool = False, nonnegative: bool = False) -> float:
     """A finite real scalar; ``positive``/``nonnegative`` add a sign check."""
+    if type(value) is float and math.isfinite(value) and (value > 0.0 or not positive) and (value >= 0.0 or not nonnegative):
+        return value  # the common case, kept cheap for World.step
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
         if not (isinstance(value, np.ndarray) and value.shape == () and np.issubdtype(value.dtype, np.number)):
             raise TypeError(f"{name} must be a real number, got {_show(value)} ({type(value).__name__})")

@@ -1,0 +1,195 @@
+"""Free motion of every dynamic body over ``n`` steps, with recording and a guard against non-finite values.
+
+Without contacts or joints the bodies do not interact, so each body is carried through all ``n`` steps in
+registers before the next one (body-major order). That is cache friendly, lets the bodies run in parallel
+with each row written by one thread only, and gives bit-identical results in any order or thread count.
+
+If a body's state becomes non-finite, its row keeps the last good values and the kernel reports the first
+failing step; :func:`advance_free_bodies` then restores every body to where it stood before the call and
+replays exactly the steps that all bodies completed, so the world stops at its last good state.
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+
+from .._jit import inline, kernel, prange
+from ..math3d import is_finite3, load3, load4, load33, quat_is_finite, scale, store3, store4
+from ..model import Model
+from ..params import Integrator
+from ..state import State
+from .free_motion import euler_step, rk4_step, symplectic_step
+
+__all__ = ["Recording", "advance_free_bodies", "PARALLEL_MIN_WORK"]
+
+# Below this many body-steps per call the thread pool's start-up costs more than it saves.
+PARALLEL_MIN_WORK = 20_000
+
+
+class Recording(NamedTuple):
+    """Frames written every ``record_every`` steps: (frames, n, 3|4) arrays; COM positions."""
+
+    pos: np.ndarray
+    quat: np.ndarray
+    linvel: np.ndarray
+    angmom: np.ndarray
+
+
+def empty_recording(body_count: int) -> Recording:
+    return Recording(
+        np.empty((0, body_count, 3)), np.empty((0, body_count, 4)),
+        np.empty((0, body_count, 3)), np.empty((0, body_count, 3)),
+    )  # fmt: skip
+
+
+@kernel
+def _advance_body(i, bodies, gravity, force, torque, pos, quat, linvel, angmom, rec, h, n_steps, method,
+                  record_every):  # fmt: skip
+    """Carry body ``i`` through ``n_steps``; return the index of the failing step, or -1.
+
+    A compiled function of its own (not inlined): the parallel kernel's loop analysis then sees only a call.
+    """
+    inv_m = bodies.inv_mass[i]
+    inertia = load33(bodies.inertia_local, i)
+    inv_inertia = load33(bodies.inv_inertia_local, i)
+    c_lin = bodies.linear_damping[i]
+    c_ang = bodies.angular_damping[i]
+    weight = scale((gravity[0], gravity[1], gravity[2]), bodies.mass[i])
+    applied_force = load3(force, i)
+    applied_torque = load3(torque, i)
+    x, q, v, l = load3(pos, i), load4(quat, i), load3(linvel, i), load3(angmom, i)
+    failed = -1
+    for s in range(n_steps):
+        # Applied loads act during the first step only; gravity during all of them.
+        f = (weight[0] + applied_force[0], weight[1] + applied_force[1], weight[2] + applied_force[2])
+        t = applied_torque
+        if s > 0:
+            f = weight
+            t = (0.0, 0.0, 0.0)
+        if method == 0:
+            xn, qn, vn, ln = euler_step(x, q, v, l, inv_m, inertia, inv_inertia, f, t, c_lin, c_ang, h)
+        elif method == 1:
+            xn, qn, vn, ln = symplectic_step(x, q, v, l, inv_m, inertia, inv_inertia, f, t, c_lin, c_ang, h)
+        else:
+            xn, qn, vn, ln = rk4_step(x, q, v, l, inv_m, inertia, inv_inertia, f, t, c_lin, c_ang, h)
+        if not (is_finite3(xn) and quat_is_finite(qn) and is_finite3(vn) and is_finite3(ln)):
+            failed = s
+            break
+        x, q, v, l = xn, qn, vn, ln
+        if record_every > 0 and (s + 1) % record_every == 0:
+            frame = (s + 1) // record_every - 1
+            store3(rec.pos[frame], i, x)
+            store4(rec.quat[frame], i, q)
+            store3(rec.linvel[frame], i, v)
+            store3(rec.angmom[frame], i, l)
+    store3(pos, i, x)
+    store4(quat, i, q)
+    store3(linvel, i, v)
+    store3(angmom, i, l)
+    return failed
+
+
+@inline
+def _copy_static_rows(i, pos, quat, linvel, angmom, rec, n_steps, record_every):
+    """Static bodies do not move; their rows in every recorded frame are their current state."""
+    if record_every > 0:
+        for frame in range(n_steps // record_every):
+            store3(rec.pos[frame], i, load3(pos, i))
+            store4(rec.quat[frame], i, load4(quat, i))
+            store3(rec.linvel[frame], i, load3(linvel, i))
+            store3(rec.angmom[frame], i, load3(angmom, i))
+
+
+@kernel
+def _advance_serial_kernel(bodies, gravity, force, torque, pos, quat, linvel, angmom, backup, rec, failed_step, h,
+                           n_steps, method, record_every):  # fmt: skip
+    """Serial body loop. Returns the first failing step over all bodies, or -1.
+
+    ``backup`` receives each row before it moves; ``failed_step[i]`` the failing step of body ``i`` or -1.
+    """
+    for i in range(pos.shape[0]):
+        _save_row(i, pos, quat, linvel, angmom, backup)
+        failed_step[i] = -1
+        if bodies.is_dynamic[i]:
+            failed_step[i] = _advance_body(i, bodies, gravity, force, torque, pos, quat, linvel, angmom, rec,
+                                           h, n_steps, method, record_every)  # fmt: skip
+        else:
+            _copy_static_rows(i, pos, quat, linvel, angmom, rec, n_steps, record_every)
+    return _first_failure(failed_step)
+
+
+@kernel(parallel=True)
+def _advance_parallel_kernel(bodies, gravity, force, torque, pos, quat, linvel, angmom, backup, rec, failed_step,
+                             h, n_steps, method, record_every):  # fmt: skip
+    """The same loop as :func:`_advance_serial_kernel` over threads; each body's row has one writer."""
+    for i in prange(pos.shape[0]):
+        _save_row(i, pos, quat, linvel, angmom, backup)
+        failed_step[i] = -1
+        if bodies.is_dynamic[i]:
+            failed_step[i] = _advance_body(i, bodies, gravity, force, torque, pos, quat, linvel, angmom, rec,
+                                           h, n_steps, method, record_every)  # fmt: skip
+        else:
+            _copy_static_rows(i, pos, quat, linvel, angmom, rec, n_steps, record_every)
+    return _first_failure(failed_step)
+
+
+@inline
+def _save_row(i, pos, quat, linvel, angmom, backup):
+    store3(backup[0], i, load3(pos, i))
+    store4(backup[1], i, load4(quat, i))
+    store3(backup[2], i, load3(linvel, i))
+    store3(backup[3], i, load3(angmom, i))
+
+
+@inline
+def _first_failure(failed_step):
+    first = -1
+    for i in range(failed_step.shape[0]):
+        if failed_step[i] >= 0 and (first < 0 or failed_step[i] < first):
+            first = failed_step[i]
+    return first
+
+
+def advance_free_bodies(
+    model: Model,
+    state: State,
+    body_force: np.ndarray,
+    body_torque: np.ndarray,
+    scratch,
+    h: float,
+    n_steps: int,
+    method: Integrator,
+    recording: Recording | None = None,
+    record_every: int = 0,
+) -> tuple[int, int]:
+    """Integrate every dynamic body for ``n_steps`` steps of ``h``.
+
+    Reads: model.body_*, model.gravity, body_force, body_torque (applied during the first step only).
+    Writes: state.body_pos/quat/linvel/angmom, ``recording`` (one frame every ``record_every`` steps),
+    scratch.backup_* and scratch.failed_step.
+
+    Returns:
+        ``(steps_done, failing_body)``: ``steps_done == n_steps`` and ``failing_body == -1`` on success;
+        otherwise the state is that after ``steps_done`` steps (the last good one) and ``failing_body`` is
+        the row of the first body whose state became non-finite in the next step.
+    """
+    bodies = model.body_arrays
+    if recording is None:
+        recording, record_every = scratch.no_recording, 0
+    arrays = (state.body_pos, state.body_quat, state.body_linvel, state.body_angmom)
+    run = _advance_parallel_kernel if model.body_count * n_steps >= PARALLEL_MIN_WORK else _advance_serial_kernel
+    first_failure = run(bodies, model.gravity, body_force, body_torque, *arrays, scratch.backup, recording,
+                        scratch.failed_step, h, n_steps, int(method), record_every)  # fmt: skip
+    if first_failure < 0:
+        return n_steps, -1
+    # Roll every body back and replay only the steps that all of them completed.
+    steps_done = int(first_failure)
+    failing_body = int(np.flatnonzero(scratch.failed_step == first_failure)[0])
+    for a, b in zip(arrays, scratch.backup, strict=True):
+        np.copyto(a, b)
+    if steps_done > 0:
+        _advance_serial_kernel(bodies, model.gravity, body_force, body_torque, *arrays, scratch.backup, recording,
+                               scratch.failed_step, h, steps_done, int(method), record_every)  # fmt: skip
+    return steps_done, failing_body

@@ -1,0 +1,185 @@
+"""Inline Numba helpers for the kernels: 3-vectors, quaternions and 3x3 matrices as tuples.
+
+Tuples are values in Numba, so these helpers never allocate inside a kernel's loop. Vectors are
+``(x, y, z)``; quaternions are ``(w, x, y, z)`` (scalar first, as everywhere in tumble); a 3x3 matrix is a
+row-major 9-tuple. The vectorised NumPy versions for users live in :mod:`tumble.rotation`; the unit
+tests check that both agree.
+"""
+
+from __future__ import annotations
+
+import math
+
+from ._jit import inline
+
+# --- vectors -----------------------------------------------------------------------------------------
+
+
+@inline
+def load3(array, i):
+    """Row ``i`` of an ``(n, 3)`` array as a tuple."""
+    return (array[i, 0], array[i, 1], array[i, 2])
+
+
+@inline
+def store3(array, i, v):
+    """Write the tuple ``v`` into row ``i`` of an ``(n, 3)`` array."""
+    array[i, 0] = v[0]
+    array[i, 1] = v[1]
+    array[i, 2] = v[2]
+
+
+@inline
+def load4(array, i):
+    return (array[i, 0], array[i, 1], array[i, 2], array[i, 3])
+
+
+@inline
+def store4(array, i, q):
+    array[i, 0] = q[0]
+    array[i, 1] = q[1]
+    array[i, 2] = q[2]
+    array[i, 3] = q[3]
+
+
+@inline
+def load33(array, i):
+    """The ``i``-th 3x3 matrix of an ``(n, 3, 3)`` array as a row-major 9-tuple."""
+    return (
+        array[i, 0, 0], array[i, 0, 1], array[i, 0, 2],
+        array[i, 1, 0], array[i, 1, 1], array[i, 1, 2],
+        array[i, 2, 0], array[i, 2, 1], array[i, 2, 2],
+    )  # fmt: skip
+
+
+@inline
+def add(a, b):
+    return (a[0] + b[0], a[1] + b[1], a[2] + b[2])
+
+
+@inline
+def sub(a, b):
+    return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
+
+
+@inline
+def scale(a, s):
+    return (a[0] * s, a[1] * s, a[2] * s)
+
+
+@inline
+def add_scaled(a, b, s):
+    """``a + s b``."""
+    return (a[0] + s * b[0], a[1] + s * b[1], a[2] + s * b[2])
+
+
+@inline
+def dot(a, b):
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+
+@inline
+def cross(a, b):
+    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
+
+
+@inline
+def is_finite3(a):
+    return math.isfinite(a[0]) and math.isfinite(a[1]) and math.isfinite(a[2])
+
+
+# --- 3x3 matrices ------------------------------------------------------------------------------------
+
+
+@inline
+def mat_vec(m, v):
+    """``M v`` for a row-major 9-tuple ``M``."""
+    return (
+        m[0] * v[0] + m[1] * v[1] + m[2] * v[2],
+        m[3] * v[0] + m[4] * v[1] + m[5] * v[2],
+        m[6] * v[0] + m[7] * v[1] + m[8] * v[2],
+    )
+
+
+@inline
+def solve33(m, b):
+    """``M⁻¹ b`` by Cramer's rule (``M`` well conditioned: an inertia-like matrix)."""
+    c0 = (m[4] * m[8] - m[5] * m[7], m[5] * m[6] - m[3] * m[8], m[3] * m[7] - m[4] * m[6])
+    det = m[0] * c0[0] + m[1] * c0[1] + m[2] * c0[2]
+    inv_det = 1.0 / det
+    x0 = (b[0] * c0[0] + b[1] * (m[2] * m[7] - m[1] * m[8]) + b[2] * (m[1] * m[5] - m[2] * m[4])) * inv_det
+    x1 = (b[0] * c0[1] + b[1] * (m[0] * m[8] - m[2] * m[6]) + b[2] * (m[2] * m[3] - m[0] * m[5])) * inv_det
+    x2 = (b[0] * c0[2] + b[1] * (m[1] * m[6] - m[0] * m[7]) + b[2] * (m[0] * m[4] - m[1] * m[3])) * inv_det
+    return (x0, x1, x2)
+
+
+# --- quaternions -------------------------------------------------------------------------------------
+
+
+@inline
+def quat_mul(p, q):
+    """Hamilton product ``p ⊗ q``."""
+    return (
+        p[0] * q[0] - p[1] * q[1] - p[2] * q[2] - p[3] * q[3],
+        p[0] * q[1] + p[1] * q[0] + p[2] * q[3] - p[3] * q[2],
+        p[0] * q[2] - p[1] * q[3] + p[2] * q[0] + p[3] * q[1],
+        p[0] * q[3] + p[1] * q[2] - p[2] * q[1] + p[3] * q[0],
+    )
+
+
+@inline
+def quat_conj(q):
+    return (q[0], -q[1], -q[2], -q[3])
+
+
+@inline
+def quat_normalize(q):
+    inv = 1.0 / math.sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3])
+    return (q[0] * inv, q[1] * inv, q[2] * inv, q[3] * inv)
+
+
+@inline
+def quat_rotate(q, v):
+    """``q v q*`` for a unit quaternion, as ``v + 2 w (u × v) + 2 u × (u × v)`` with ``u`` the vector part."""
+    u = (q[1], q[2], q[3])
+    t = scale(cross(u, v), 2.0)
+    return add(add_scaled(v, t, q[0]), cross(u, t))
+
+
+@inline
+def quat_rotate_inv(q, v):
+    """``q* v q``: a world vector expressed in the body frame."""
+    return quat_rotate(quat_conj(q), v)
+
+
+@inline
+def quat_derivative(q, w):
+    """``dq/dt = ½ (0, ω) ⊗ q`` with ``ω`` in the world frame."""
+    dq = quat_mul((0.0, w[0], w[1], w[2]), q)
+    return (0.5 * dq[0], 0.5 * dq[1], 0.5 * dq[2], 0.5 * dq[3])
+
+
+@inline
+def quat_add_scaled(q, dq, s):
+    """``q + s dq`` for 4-tuples."""
+    return (q[0] + s * dq[0], q[1] + s * dq[1], q[2] + s * dq[2], q[3] + s * dq[3])
+
+
+@inline
+def quat_integrate(q, w, h):
+    """First-order update ``q + h ½ (0, ω) ⊗ q``, renormalised."""
+    return quat_normalize(quat_add_scaled(q, quat_derivative(q, w), h))
+
+
+@inline
+def quat_is_finite(q):
+    return math.isfinite(q[0]) and math.isfinite(q[1]) and math.isfinite(q[2]) and math.isfinite(q[3])
+
+
+# --- inertia -----------------------------------------------------------------------------------------
+
+
+@inline
+def world_inertia_apply(q, inertia_local, v):
+    """``R I Rᵀ v``: apply a body-frame inertia-like 9-tuple to a world vector."""
+    return quat_rotate(q, mat_vec(inertia_local, quat_rotate_inv(q, v)))

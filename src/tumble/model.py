@@ -1,0 +1,96 @@
+"""Model: what the world *is* — masses, inertias, shapes, materials. Built once by the builder.
+
+Structure of arrays, prefix-named (``body_*``, ``shape_*``). Constant during a step; rebuilt by
+:class:`~tumble.builder.ModelBuilder` when bodies are added.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import cached_property
+from typing import NamedTuple
+
+import numpy as np
+
+__all__ = ["Model", "BodyArrays"]
+
+
+class BodyArrays(NamedTuple):
+    """The model's per-body arrays that the integrators read (a NamedTuple Numba accepts)."""
+
+    mass: np.ndarray  # (n,) [kg]
+    inv_mass: np.ndarray  # (n,) [1/kg]
+    inertia_local: np.ndarray  # (n, 3, 3) [kg m²]
+    inv_inertia_local: np.ndarray  # (n, 3, 3)
+    is_dynamic: np.ndarray  # (n,) bool
+    linear_damping: np.ndarray  # (n,) [1/s]
+    angular_damping: np.ndarray  # (n,) [1/s]
+
+
+@dataclass(frozen=True, eq=False)
+class Model:
+    """Static arrays of a world.
+
+    Attributes:
+        gravity: (3,) float64 [m/s²], world frame.
+        body_mass: (body_count,) float64 [kg]; 0 for static bodies.
+        body_inv_mass: (body_count,) float64 [1/kg]; 0 for static bodies.
+        body_inertia_local: (body_count, 3, 3) float64 [kg m²], about the COM, body frame.
+        body_inv_inertia_local: (body_count, 3, 3) float64; zeros for static bodies.
+        body_com_local: (body_count, 3) float64 [m], the COM in the body frame (from the frame origin).
+        body_is_dynamic: (body_count,) bool.
+        body_linear_damping, body_angular_damping: (body_count,) float64 [1/s].
+        body_name: body names (``None`` where unnamed), in row order.
+        shape_body: (shape_count,) int64, the body row each shape belongs to.
+        shape_type: (shape_count,) int64, :class:`~tumble.shapes.ShapeType` codes.
+        shape_params: (shape_count, 4) float64, per-type sizes (see ``Shape.params``).
+        shape_pos_local: (shape_count, 3) float64 [m], shape origin relative to the body COM, body frame.
+        shape_quat_local: (shape_count, 4) float64, shape orientation in the body frame.
+        shape_friction, shape_restitution: (shape_count,) float64.
+        shapes: the shape objects, in row order (for geometry that does not fit the arrays).
+    """
+
+    gravity: np.ndarray
+    body_mass: np.ndarray
+    body_inv_mass: np.ndarray
+    body_inertia_local: np.ndarray
+    body_inv_inertia_local: np.ndarray
+    body_com_local: np.ndarray
+    body_is_dynamic: np.ndarray
+    body_linear_damping: np.ndarray
+    body_angular_damping: np.ndarray
+    body_name: tuple
+    shape_body: np.ndarray
+    shape_type: np.ndarray
+    shape_params: np.ndarray
+    shape_pos_local: np.ndarray
+    shape_quat_local: np.ndarray
+    shape_friction: np.ndarray
+    shape_restitution: np.ndarray
+    shapes: tuple
+
+    @property
+    def body_count(self) -> int:
+        return int(self.body_mass.shape[0])
+
+    @property
+    def shape_count(self) -> int:
+        return int(self.shape_body.shape[0])
+
+    @cached_property
+    def body_arrays(self) -> BodyArrays:
+        """The per-body arrays the integrators read, as one NamedTuple for the kernels."""
+        return BodyArrays(
+            self.body_mass,
+            self.body_inv_mass,
+            self.body_inertia_local,
+            self.body_inv_inertia_local,
+            self.body_is_dynamic,
+            self.body_linear_damping,
+            self.body_angular_damping,
+        )
+
+    @property
+    def has_constraints(self) -> bool:
+        """Whether anything couples bodies (contacts or joints); free-motion integrators apply if not."""
+        return False

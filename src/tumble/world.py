@@ -1,0 +1,377 @@
+"""World: the Pythonic facade over the model, state and inputs arrays.
+
+``add_*`` calls go to a :class:`~tumble.builder.ModelBuilder`; the arrays are rebuilt lazily the next time
+they are needed, so adding thousands of bodies costs linear time. ``world.state`` exposes the arrays for
+batch work (re-read it after adding bodies: adding reallocates them).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+
+from . import diagnostics
+from ._validate import as_float, as_quaternion, as_vector3, mass_or_density
+from .builder import ModelBuilder, ShapeSpec
+from .errors import SimulationError
+from .handles import Body
+from .inputs import Inputs
+from .mass import MassProperties
+from .model import Model
+from .params import INTEGRATOR_NAMES, Params
+from .pipeline import simulate_steps
+from .rotation import quat_rotate
+from .scratch import Scratch
+from .shapes import Plane, Shape, TriMesh
+from .state import State
+from .trajectory import Trajectory
+
+__all__ = ["World"]
+
+_IDENTITY = np.array([1.0, 0.0, 0.0, 0.0])
+
+
+def _check_integrator(integrator) -> str:
+    names = ("auto", *INTEGRATOR_NAMES)
+    if not isinstance(integrator, str) or integrator not in names:
+        raise ValueError(f"integrator must be one of {names}, got {integrator!r}")
+    return integrator
+
+
+def _shape_items(shape, friction: float, restitution: float) -> list[ShapeSpec]:
+    """``None``, one shape, or a list of ``(shape, position[, orientation])`` in the body frame."""
+    if shape is None:
+        return []
+    if isinstance(shape, Shape):
+        return [ShapeSpec(shape, np.zeros(3), _IDENTITY.copy(), friction, restitution)]
+    if not isinstance(shape, Sequence) or isinstance(shape, str) or len(shape) == 0:
+        raise TypeError(
+            "shape must be a Shape, a non-empty list of (shape, position[, orientation]) or None, "
+            f"got {shape!r}"
+        )
+    items = []
+    for k, item in enumerate(shape):
+        if not isinstance(item, Sequence) or len(item) not in (2, 3) or not isinstance(item[0], Shape):
+            raise TypeError(f"shape[{k}] must be (shape, position[, orientation]), got {item!r}")
+        position = as_vector3(f"shape[{k}] position", item[1])
+        quat = as_quaternion(f"shape[{k}] orientation", item[2]) if len(item) == 3 else _IDENTITY.copy()
+        items.append(ShapeSpec(item[0], position, quat, friction, restitution))
+    return items
+
+
+def _body_mass_properties(items: list[ShapeSpec], mass, density, inertia) -> MassProperties:
+    """Mass properties in the body frame: from the shapes (``mass=`` spread by volume) or explicit."""
+    if not items:
+        if density is not None:
+            raise ValueError(f"density={density!r} needs a shape; a body without geometry takes mass= and inertia=")
+        if mass is None or inertia is None:
+            raise ValueError(
+                "a body without geometry (shape=None) needs both mass= and inertia=, "
+                f"got mass={mass!r}, inertia={inertia!r}"
+            )
+        return MassProperties(as_float("mass", mass, positive=True), np.zeros(3), inertia)
+    for k, item in enumerate(items):
+        if isinstance(item.shape, (Plane, TriMesh)):
+            raise ValueError(
+                f"shape[{k}]: a {type(item.shape).__name__} can only be static; use world.add_static "
+                "(or ConvexHull for a dynamic body)"
+            )
+    kind, value = mass_or_density(mass, density)
+    per_volume = value if kind == "density" else 1.0
+    mp = sum(
+        it.shape.mass_properties(density=per_volume).transformed(rotation=it.quat, translation=it.position)
+        for it in items
+    )
+    if kind == "mass":
+        mp = mp.scaled_to(value)
+    if inertia is not None:
+        mp = MassProperties(mp.mass, mp.com, inertia)
+    return mp
+
+
+def _require_definite(mp: MassProperties) -> None:
+    moments = np.linalg.eigvalsh(mp.inertia)
+    if moments[0] <= 1e-12 * moments[-1]:
+        raise ValueError(
+            f"inertia must be positive definite for a dynamic body, got principal moments {moments.tolist()}"
+        )
+
+
+class World:
+    """A set of rigid bodies under gravity.
+
+    Args:
+        gravity: (3,) [m/s²], world frame.
+        integrator: ``"auto"`` (default: RK4 in momentum form while nothing couples the bodies), ``"rk4"``,
+            ``"symplectic"`` (semi-implicit Euler) or ``"euler"`` (explicit, as in the course notes).
+    """
+
+    def __init__(self, gravity=(0.0, 0.0, -9.81), *, integrator: str = "auto"):
+        self._gravity = as_vector3("gravity", gravity)
+        self._params = Params(integrator=_check_integrator(integrator))
+        self._builder = ModelBuilder()
+        self._model: Model | None = None
+        self._state = State.empty(0)
+        self._inputs = Inputs.zeros(0)
+        self._scratch = Scratch.for_bodies(0)
+        self._pending: list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = []
+        self._bodies: list[Body] = []
+
+    # --- building -----------------------------------------------------------------------------------
+
+    def add_body(
+        self,
+        shape=None,
+        *,
+        mass=None,
+        density=None,
+        inertia=None,
+        position=(0.0, 0.0, 0.0),
+        orientation=(1.0, 0.0, 0.0, 0.0),
+        velocity=(0.0, 0.0, 0.0),
+        angular_velocity=(0.0, 0.0, 0.0),
+        friction: float = 0.5,
+        restitution: float = 0.0,
+        linear_damping: float = 0.0,
+        angular_damping: float = 0.0,
+        name: str | None = None,
+    ) -> Body:
+        """Add a dynamic body; see ``docs/api.md``. ``velocity`` is that of the centre of mass."""
+        position = as_vector3("position", position)
+        quat = as_quaternion("orientation", orientation)
+        velocity = as_vector3("velocity", velocity)
+        angular_velocity = as_vector3("angular_velocity", angular_velocity)
+        friction, restitution = self._check_material(friction, restitution)
+        linear_damping = as_float("linear_damping", linear_damping, nonnegative=True)
+        angular_damping = as_float("angular_damping", angular_damping, nonnegative=True)
+        name = self._check_name(name)
+        items = _shape_items(shape, friction, restitution)
+        mp = _body_mass_properties(items, mass, density, inertia)
+        _require_definite(mp)
+        com = position + quat_rotate(quat, mp.com)
+        angmom = diagnostics.world_tensor_apply(mp.inertia[None], quat[None], angular_velocity[None])[0]
+        index = self._builder.add_body(
+            mp, items, linear_damping=linear_damping, angular_damping=angular_damping, name=name
+        )
+        return self._append(index, com, quat, velocity, angmom)
+
+    def add_static(
+        self,
+        shape,
+        *,
+        position=(0.0, 0.0, 0.0),
+        orientation=(1.0, 0.0, 0.0, 0.0),
+        friction: float = 0.5,
+        restitution: float = 0.0,
+        name: str | None = None,
+    ) -> Body:
+        """Add fixed geometry (a plane, a mesh, any shape, or a compound list); it never moves."""
+        if shape is None:
+            raise TypeError("add_static needs a shape, got None")
+        position = as_vector3("position", position)
+        quat = as_quaternion("orientation", orientation)
+        friction, restitution = self._check_material(friction, restitution)
+        name = self._check_name(name)
+        items = _shape_items(shape, friction, restitution)
+        index = self._builder.add_body(None, items, name=name)
+        return self._append(index, position, quat, np.zeros(3), np.zeros(3))
+
+    @staticmethod
+    def _check_material(friction, restitution) -> tuple[float, float]:
+        friction = as_float("friction", friction, nonnegative=True)
+        restitution = as_float("restitution", restitution, nonnegative=True)
+        if restitution > 1.0:
+            raise ValueError(f"restitution must be in [0, 1], got {restitution!r}")
+        return friction, restitution
+
+    def _check_name(self, name) -> str | None:
+        if name is None:
+            return None
+        if not isinstance(name, str) or not name:
+            raise TypeError(f"name must be a non-empty string or None, got {name!r}")
+        if name in self._builder_names():
+            raise ValueError(f"name must be unique in the world, {name!r} is already taken")
+        return name
+
+    def _builder_names(self) -> set[str]:
+        return {row.name for row in self._builder.rows if row.name is not None}
+
+    def _append(self, index, com, quat, velocity, angmom) -> Body:
+        self._pending.append((com, quat, velocity, angmom))
+        self._model = None
+        body = Body(self, index)
+        self._bodies.append(body)
+        return body
+
+    def _sync(self) -> None:
+        """Rebuild the model and grow the state after ``add_*`` calls."""
+        if self._model is not None:
+            return
+        self._model = self._builder.finalize(self._gravity)
+        if self._pending:
+            new = [np.array(column) for column in zip(*self._pending, strict=True)]
+            old = self._state
+            self._state = State(
+                *(np.concatenate([a, b]) for a, b in zip(old.arrays().values(), new, strict=True)),
+                time=old.time,
+                step_count=old.step_count,
+            )
+            added = Inputs.zeros(len(self._pending))
+            self._inputs = Inputs(
+                np.concatenate([self._inputs.body_force, added.body_force]),
+                np.concatenate([self._inputs.body_torque, added.body_torque]),
+            )
+            self._pending.clear()
+            self._scratch = Scratch.for_bodies(self._state.body_count)
+
+    # --- arrays -------------------------------------------------------------------------------------
+
+    @property
+    def model(self) -> Model:
+        """The static arrays (masses, inertias, shapes)."""
+        self._sync()
+        return self._model
+
+    @property
+    def state(self) -> State:
+        """The dynamic arrays (``body_pos`` is the COM); views, for batch reads and writes."""
+        self._sync()
+        return self._state
+
+    @property
+    def inputs(self) -> Inputs:
+        """The applied forces and torques of the next step."""
+        self._sync()
+        return self._inputs
+
+    @property
+    def bodies(self) -> list[Body]:
+        """Every body, dynamic and static, in the order they were added."""
+        return list(self._bodies)
+
+    def body(self, name: str) -> Body:
+        """The body called ``name``."""
+        for b in self._bodies:
+            if b.name == name:
+                return b
+        raise KeyError(f"no body named {name!r}; names: {sorted(self._builder_names())}")
+
+    @property
+    def gravity(self) -> np.ndarray:
+        return self._gravity.copy()
+
+    @gravity.setter
+    def gravity(self, value) -> None:
+        self._gravity = as_vector3("gravity", value)
+        self._model = None
+
+    @property
+    def integrator(self) -> str:
+        return self._params.integrator
+
+    @integrator.setter
+    def integrator(self, value: str) -> None:
+        self._params.integrator = _check_integrator(value)
+
+    @property
+    def time(self) -> float:
+        return self._state.time
+
+    @property
+    def step_count(self) -> int:
+        return self._state.step_count
+
+    # --- stepping -----------------------------------------------------------------------------------
+
+    def step(self, dt: float) -> None:
+        """Advance one step of ``dt`` seconds. Applied forces act during this step only.
+
+        Raises:
+            SimulationError: the step produced a non-finite value; the world keeps its state from before.
+        """
+        dt = as_float("dt", dt, positive=True)
+        self._sync()
+        steps_done, failing = simulate_steps(
+            self._model, self._state, self._inputs, self._params, self._scratch, dt
+        )
+        if failing >= 0:
+            raise self._simulation_error(failing)
+
+    def simulate(self, duration: float, dt: float, record_every: int = 1) -> Trajectory:
+        """Take ``round(duration / dt)`` steps in one compiled loop, recording every ``record_every`` steps.
+
+        The trajectory starts with the current state. On a :class:`SimulationError` the world keeps its last
+        good state and the error's ``trajectory`` holds the frames recorded up to it.
+        """
+        duration = as_float("duration", duration, positive=True)
+        dt = as_float("dt", dt, positive=True)
+        if isinstance(record_every, bool) or not isinstance(record_every, (int, np.integer)) or record_every < 1:
+            raise ValueError(f"record_every must be an integer >= 1, got {record_every!r}")
+        n_steps = round(duration / dt)
+        if n_steps < 1:
+            raise ValueError(f"duration={duration!r} is shorter than one step of dt={dt!r}")
+        self._sync()
+        t0, initial = self._state.time, self._state.copy()
+        recording = Trajectory.allocate_recording(self._state.body_count, n_steps // record_every)
+        steps_done, failing = simulate_steps(
+            self._model, self._state, self._inputs, self._params, self._scratch, dt, n_steps, recording,
+            int(record_every),
+        )
+        frames = steps_done // record_every
+        trajectory = Trajectory.from_recording(
+            self._model, initial, recording, frames, t0 + dt * record_every * np.arange(1, frames + 1), dt
+        )
+        if failing >= 0:
+            error = self._simulation_error(failing)
+            error.trajectory = trajectory
+            raise error
+        return trajectory
+
+    def _simulation_error(self, row: int) -> SimulationError:
+        name = self._model.body_name[row]
+        label = repr(name) if name is not None else f"#{row}"
+        step = self._state.step_count
+        return SimulationError(
+            f"body {label} became non-finite (NaN or Inf) in step {step} (t = {self._state.time:.6g} s); "
+            "the world keeps its state from before that step",
+            body=name if name is not None else row,
+            step=step,
+        )
+
+    # --- diagnostics --------------------------------------------------------------------------------
+
+    def angular_velocities(self) -> np.ndarray:
+        """ω = R I⁻¹ Rᵀ L of every body: (body_count, 3) [rad/s], world frame (zeros for static bodies)."""
+        m, s = self.model, self._state
+        return diagnostics.world_tensor_apply(m.body_inv_inertia_local, s.body_quat, s.body_angmom)
+
+    def kinetic_energy(self) -> float:
+        """Σ ½ m |v|² + ½ ω·L [J]."""
+        s = self.state
+        omega = self.angular_velocities()
+        return float(diagnostics.kinetic_energy(self._model.body_mass, s.body_linvel, omega, s.body_angmom).sum())
+
+    def potential_energy(self) -> float:
+        """Gravitational potential energy −Σ m g·x_com [J] (zero at the origin)."""
+        return float(diagnostics.potential_energy(self.model.body_mass, self._state.body_pos, self._gravity).sum())
+
+    def total_energy(self) -> float:
+        return self.kinetic_energy() + self.potential_energy()
+
+    def linear_momentum(self) -> np.ndarray:
+        """Σ m v [kg m/s], world frame."""
+        return diagnostics.linear_momentum(self.model.body_mass, self._state.body_linvel)
+
+    def angular_momentum(self, point=(0.0, 0.0, 0.0)) -> np.ndarray:
+        """Σ (x − p) × m v + L about ``point`` [kg m²/s], world frame (``L`` each body's spin)."""
+        point = as_vector3("point", point)
+        s = self.state
+        return diagnostics.angular_momentum(self._model.body_mass, s.body_pos, s.body_linvel, s.body_angmom, point)
+
+    def __repr__(self) -> str:
+        dynamic = sum(1 for b in self._bodies if not b.is_static)
+        return (
+            f"World(bodies={len(self._bodies)} ({dynamic} dynamic), t={self.time:.6g} s, "
+            f"integrator={self.integrator!r}, gravity={self._gravity.tolist()})"
+        )
