@@ -38,7 +38,11 @@ def simulate_steps(
         model, state, inputs.body_force, inputs.body_torque, scratch, h, n_steps, method, recording, record_every
     )
     state.step_count += steps_done
-    state.time = state.time + steps_done * h
+    # Accumulate time step by step so that simulate(n steps) and n calls of step() agree bit for bit.
+    time = state.time
+    for _ in range(steps_done):
+        time += h
+    state.time = time
     if steps_done > 0:
         inputs.clear()
     return steps_done, failing_body
