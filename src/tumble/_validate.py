@@ -83,7 +83,7 @@ def as_rotation(name: str, value) -> np.ndarray:
 
         return quat_to_matrix(as_quaternion(name, array))
     matrix = as_array(name, value, (3, 3), batch=False)
-    if not np.allclose(matrix.T @ matrix, np.eye(3), atol=1e-9) or np.linalg.det(matrix) < 0.0:
+    if not np.allclose(matrix.T @ matrix, np.eye(3), atol=1e-6) or np.linalg.det(matrix) < 0.0:
         raise ValueError(f"{name} must be a proper rotation matrix (orthonormal, det +1), got {_show(matrix)}")
     return matrix.copy()
 

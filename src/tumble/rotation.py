@@ -334,9 +334,10 @@ def quat_from_rotvec(r) -> np.ndarray:
 def quat_to_rotvec(q) -> np.ndarray:
     """The logarithm map: the rotation vector ``θ ê`` of ``q``, with ``θ`` in ``[0, π]``.
 
-    For ``q = (w, u)`` taken with ``w >= 0``: ``θ = 2 atan2(|u|, w)`` and ``θ ê = (θ / |u|) u``. Near the
-    identity ``θ / |u| = (2/w)(1 - s²/3 + ...)`` with ``s = |u|/w`` (the series of ``2 atan(s)/s``), so tiny
-    rotations keep full relative precision and the identity maps to zero. ``q`` need not be unit.
+    For ``q = (w, u)`` taken with ``w >= 0``: ``θ = 2 atan2(|u|, w)`` and ``θ ê = (θ / |u|) u``. Unlike
+    ``2 acos(w)``, ``atan2`` keeps full relative precision for tiny rotations; near the identity the ratio
+    ``θ / |u|`` (0/0 at the identity itself) is taken from its series ``(2/w)(1 - s²/3 + s⁴/5)`` with
+    ``s = |u|/w``, so the identity maps to exactly zero. ``q`` need not be unit.
 
     Args:
         q: (..., 4) non-zero quaternions.
