@@ -4,17 +4,17 @@ Every shape carries the data the kernels will need in structure-of-arrays form, 
 shapes pack into ``shape_type (n,)``, ``shape_params (n, 4)`` and one concatenated vertex array (plus a
 face array) addressed by a start and a count per shape:
 
-======================  ======================  =====================================================
-shape                   ``params`` (4,)         geometry in the shape frame
-======================  ======================  =====================================================
-``Sphere(radius)``      ``(r, 0, 0, 0)``        centred at the origin
-``Capsule(r, length)``  ``(r, length/2, 0, 0)`` segment ``z ∈ [-length/2, length/2]`` swept by ``r``
-``Box(extents)``        ``(hx, hy, hz, 0)``     HALF extents; ``extents`` are full edge lengths
-``Cylinder(r, height)`` ``(r, height/2, 0, 0)`` axis z, centred
-``ConvexHull(points)``  zeros                   ``vertices (v, 3)``, outward ``faces (f, 3)``
-``Plane(normal, off)``  ``(nx, ny, nz, off)``   the points ``n · x = off``; solid side ``n · x <= off``
-``TriMesh(v, f)``       zeros                   ``vertices (v, 3)``, ``faces (f, 3)`` as given
-======================  ======================  =====================================================
+=======================  =======================  =======================================================
+shape                    ``params`` (4,)          geometry in the shape frame
+=======================  =======================  =======================================================
+``Sphere(radius)``       ``(r, 0, 0, 0)``         centred at the origin
+``Capsule(r, length)``   ``(r, length/2, 0, 0)``  segment ``z ∈ [-length/2, length/2]`` swept by ``r``
+``Box(extents)``         ``(hx, hy, hz, 0)``      HALF extents; ``extents`` are full edge lengths
+``Cylinder(r, height)``  ``(r, height/2, 0, 0)``  axis z, centred
+``ConvexHull(points)``   zeros                    ``vertices (v, 3)``, outward ``faces (f, 3)``
+``Plane(normal, off)``   ``(nx, ny, nz, off)``    the points ``n · x = off``; solid side ``n · x <= off``
+``TriMesh(v, f)``        zeros                    ``vertices (v, 3)``, ``faces (f, 3)`` as given
+=======================  =======================  =======================================================
 
 :class:`ShapeType` numbers the kinds; a collision kernel for a pair is ``collide_<a>_<b>`` with the lower
 type first, and new kinds are appended at the end. Mass properties come from :mod:`tumble.mass` and are
