@@ -1,0 +1,46 @@
+"""Every example runs headless with few steps; its summary line is pinned (a regex, with why it last changed)."""
+
+from __future__ import annotations
+
+import importlib.util
+import re
+from pathlib import Path
+
+import pytest
+
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+
+PINNED = {
+    # Exact parabola and RK4 energy conservation (pinned at the first version).
+    "basic/hello_world.py": r"final: t=1\.00 s, z=1\.0950 m, energy drift \de-(09|1\d)",
+    # 5 s of the T-handle at 12 rad/s: the first flip is at 2.16 s; energy and |L| conserved (first version).
+    "basic/dzhanibekov.py": r"final: 1 flips in 5\.0 s, energy drift \d\.\de-1\d, \|L\| drift \d\.\de-1[4-6]",
+}
+STEPS = {"basic/hello_world.py": 100, "basic/dzhanibekov.py": 5000}
+
+
+def load(relative: str):
+    spec = importlib.util.spec_from_file_location(relative.replace("/", "_")[:-3], EXAMPLES / relative)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_every_example_is_pinned():
+    found = {p.relative_to(EXAMPLES).as_posix() for p in EXAMPLES.rglob("*.py")}
+    assert found == set(PINNED)
+
+
+@pytest.mark.parametrize("relative", sorted(PINNED))
+def test_example_summary(relative):
+    module = load(relative)
+    assert module.__doc__ and "Run:" in module.__doc__
+    summary = module.main(steps=STEPS[relative], render=False)
+    assert re.fullmatch(PINNED[relative], summary), summary
+
+
+def test_demo_writes_its_plot(tmp_path, monkeypatch):
+    module = load("basic/dzhanibekov.py")
+    monkeypatch.setattr(module, "OUT", tmp_path)
+    module.main(steps=3000, render=True)
+    assert (tmp_path / "dzhanibekov.png").stat().st_size > 10_000
