@@ -12,7 +12,7 @@ from __future__ import annotations
 
 __version__ = "0.1.0"
 
-from . import mass, rotation
+from . import mass, rotation, shapes
 from .errors import SimulationError
 from .handles import Body
 from .mass import MassProperties
@@ -38,4 +38,5 @@ __all__ = [
     "__version__",
     "mass",
     "rotation",
+    "shapes",
 ]

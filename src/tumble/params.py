@@ -14,9 +14,15 @@ class Integrator(IntEnum):
     EULER = 0  # explicit Euler on (x, q, p, L), as in the course notes (course/003)
     SYMPLECTIC = 1  # semi-implicit Euler, gyroscopic term by one implicit Newton step
     RK4 = 2  # classical Runge-Kutta on (x, q, p, L), quaternion renormalised
+    MIDPOINT = 3  # Lie-Poisson implicit midpoint with the Cayley map: E and L conserved to round-off
 
 
-INTEGRATOR_NAMES = {"euler": Integrator.EULER, "symplectic": Integrator.SYMPLECTIC, "rk4": Integrator.RK4}
+INTEGRATOR_NAMES = {
+    "euler": Integrator.EULER,
+    "symplectic": Integrator.SYMPLECTIC,
+    "rk4": Integrator.RK4,
+    "midpoint": Integrator.MIDPOINT,
+}
 
 
 @dataclass

@@ -104,7 +104,9 @@ class World:
     Args:
         gravity: (3,) [m/s²], world frame.
         integrator: ``"auto"`` (default: RK4 in momentum form while nothing couples the bodies), ``"rk4"``,
+            ``"midpoint"`` (Lie–Poisson implicit midpoint: energy and L conserved to round-off),
             ``"symplectic"`` (semi-implicit Euler) or ``"euler"`` (explicit, as in the course notes).
+            ``docs/integrators.md`` says which to use when.
     """
 
     def __init__(self, gravity=(0.0, 0.0, -9.81), *, integrator: str = "auto"):

@@ -11,7 +11,7 @@ from tumble.rotation import quat_derivative, quat_to_matrix
 
 INERTIA = np.diag([1.0, 2.0, 3.0])
 OMEGA0 = np.array([0.01, 5.0, 0.01])  # near the intermediate axis: the Dzhanibekov flip
-INTEGRATORS = ["euler", "symplectic", "rk4", "auto"]
+INTEGRATORS = ["euler", "symplectic", "rk4", "midpoint", "auto"]
 
 
 def tumbling_world(integrator="auto", omega=OMEGA0, inertia=INERTIA):
@@ -55,7 +55,7 @@ def half_periods(times, omega_body_y):
     return np.diff(crossings)
 
 
-@pytest.mark.parametrize("integrator", ["symplectic", "rk4", "auto"])
+@pytest.mark.parametrize("integrator", ["symplectic", "rk4", "midpoint", "auto"])
 def test_dzhanibekov_flip_half_period_matches_euler_equations(integrator):
     world, _ = tumbling_world(integrator)
     traj = world.simulate(20.0, 1e-3)
@@ -63,7 +63,7 @@ def test_dzhanibekov_flip_half_period_matches_euler_equations(integrator):
     ref = euler_equations_reference(20.0, t_eval=traj.time)
     expected = half_periods(ref.t, ref.y[1])
     assert len(measured) >= 2 and len(measured) == len(expected)
-    # 0.5 % is the bound; measured: rk4 ~1e-9, symplectic ~2e-4 relative.
+    # 0.5 % is the bound; measured: rk4 4e-9, midpoint 4e-7, symplectic 1.3e-4 relative.
     np.testing.assert_allclose(measured, expected, rtol=5e-3)
 
 
@@ -91,6 +91,15 @@ def test_default_integrator_conserves_angular_momentum_and_energy():
     assert np.max(np.abs(traj.total_energy - E0)) / E0 < 1e-9  # measured ~1e-11
 
 
+def test_midpoint_conserves_both_quadratic_invariants_to_round_off_even_at_a_large_step():
+    world, body = tumbling_world("midpoint")
+    L0, E0 = body.angular_momentum, world.total_energy()
+    traj = world.simulate(20.0, 1e-2)
+    L = traj.angular_momentum()
+    assert np.max(np.linalg.norm(L - L0, axis=-1)) / np.linalg.norm(L0) < 1e-13  # measured 3e-15
+    assert np.max(np.abs(traj.total_energy - E0)) / E0 < 1e-13  # measured 2e-15 (RK4 here: 4e-8)
+
+
 def test_explicit_euler_gains_energy_as_the_course_warns():
     world, _ = tumbling_world("euler")
     traj = world.simulate(2.0, 1e-3, record_every=100)
@@ -99,7 +108,9 @@ def test_explicit_euler_gains_energy_as_the_course_warns():
     assert traj.total_energy[-1] > traj.total_energy[0] * (1 + 5e-5)  # measured +8e-5 over 2 s
 
 
-@pytest.mark.parametrize(("integrator", "order"), [("euler", 1), ("symplectic", 1), ("rk4", 4)])
+@pytest.mark.parametrize(
+    ("integrator", "order"), [("euler", 1), ("symplectic", 1), ("midpoint", 2), ("rk4", 4)]
+)
 def test_integrators_converge_at_their_order(integrator, order):
     q0 = np.array([1.0, 0.0, 0.0, 0.0])
     w0 = np.array([0.4, 1.0, -0.6])
@@ -111,7 +122,7 @@ def test_integrators_converge_at_their_order(integrator, order):
         world.simulate(t_end, dt, record_every=round(t_end / dt))
         errors.append(np.linalg.norm(body.angular_velocity - w_ref))
     ratios = np.array(errors[:-1]) / np.array(errors[1:])
-    # Halving dt divides the error by ≈ 2^order; measured ≈ 2.0 / 2.0 / 16.0.
+    # Halving dt divides the error by ≈ 2^order; measured ≈ 2.0 / 2.0 / 4.0 / 16.0.
     np.testing.assert_allclose(ratios, 2.0**order, rtol=0.15)
 
 
@@ -152,14 +163,16 @@ def test_impulse_at_a_point_changes_velocity_and_spin_at_once():
     np.testing.assert_allclose(world.angular_momentum(), np.cross(point, impulse), rtol=1e-12)
 
 
-def test_projectile_rk4_is_exact_and_symplectic_matches_its_discrete_solution():
+def test_projectile_is_exact_for_rk4_and_midpoint_and_matches_the_discrete_euler_solutions():
     g = np.array([0.0, 0.0, -9.81])
     x0, v0, h, n = np.array([0.0, 0.0, 1.0]), np.array([3.0, 1.0, 8.0]), 1e-2, 150
-    world = tumble.World(integrator="rk4")
-    body = world.add_body(tumble.Sphere(0.1), mass=1.0, position=x0, velocity=v0)
-    world.simulate(n * h, h)
     t = n * h
-    np.testing.assert_allclose(body.position, x0 + v0 * t + 0.5 * g * t**2, rtol=0, atol=1e-12)
+    for exact in ("rk4", "midpoint"):  # RK4 and the kick-drift-kick midpoint integrate a constant force exactly
+        world = tumble.World(integrator=exact)
+        body = world.add_body(tumble.Sphere(0.1), mass=1.0, position=x0, velocity=v0)
+        world.simulate(n * h, h)
+        np.testing.assert_allclose(body.position, x0 + v0 * t + 0.5 * g * t**2, rtol=0, atol=1e-12)
+        np.testing.assert_allclose(body.velocity, v0 + g * t, rtol=0, atol=1e-12)
     # Semi-implicit Euler: v_k = v0 + k h g, x_n = x0 + n h v0 + h² g n (n + 1) / 2.
     world = tumble.World(integrator="symplectic")
     body = world.add_body(tumble.Sphere(0.1), mass=1.0, position=x0, velocity=v0)
@@ -180,7 +193,9 @@ def test_projectile_energy_is_conserved_by_rk4():
     assert np.max(np.abs(e - e[0])) / abs(e[0]) < 1e-9  # measured ~1e-12
 
 
-@pytest.mark.parametrize(("integrator", "rtol"), [("rk4", 1e-10), ("symplectic", 2e-3), ("euler", 2e-3)])
+@pytest.mark.parametrize(
+    ("integrator", "rtol"), [("rk4", 1e-10), ("midpoint", 2e-3), ("symplectic", 2e-3), ("euler", 2e-3)]
+)
 def test_linear_damping_decays_velocity_exponentially(integrator, rtol):
     world = tumble.World(gravity=(0, 0, 0), integrator=integrator)
     body = world.add_body(tumble.Sphere(0.1), mass=1.0, velocity=(2.0, 0.0, 0.0), linear_damping=0.5)

@@ -137,7 +137,7 @@ def _scene(integrator="auto"):
     return world
 
 
-@pytest.mark.parametrize("integrator", ["euler", "symplectic", "rk4"])
+@pytest.mark.parametrize("integrator", ["euler", "symplectic", "rk4", "midpoint"])
 def test_runs_are_bit_identical_and_simulate_equals_repeated_steps(integrator):
     a, b, c = _scene(integrator), _scene(integrator), _scene(integrator)
     a.simulate(1.0, 1e-3)

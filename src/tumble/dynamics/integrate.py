@@ -20,7 +20,7 @@ from ..math3d import is_finite3, load3, load4, load33, quat_is_finite, scale, st
 from ..model import Model
 from ..params import Integrator
 from ..state import State
-from .free_motion import euler_step, rk4_step, symplectic_step
+from .free_motion import euler_step, midpoint_step, rk4_step, symplectic_step
 
 __all__ = ["Recording", "advance_free_bodies", "PARALLEL_MIN_WORK"]
 
@@ -72,8 +72,10 @@ def _advance_body(i, bodies, gravity, force, torque, pos, quat, linvel, angmom, 
             xn, qn, vn, ln = euler_step(x, q, v, l, inv_m, inertia, inv_inertia, f, t, c_lin, c_ang, h)
         elif method == 1:
             xn, qn, vn, ln = symplectic_step(x, q, v, l, inv_m, inertia, inv_inertia, f, t, c_lin, c_ang, h)
-        else:
+        elif method == 2:
             xn, qn, vn, ln = rk4_step(x, q, v, l, inv_m, inertia, inv_inertia, f, t, c_lin, c_ang, h)
+        else:
+            xn, qn, vn, ln = midpoint_step(x, q, v, l, inv_m, inertia, inv_inertia, f, t, c_lin, c_ang, h)
         if not (is_finite3(xn) and quat_is_finite(qn) and is_finite3(vn) and is_finite3(ln)):
             failed = s
             break
