@@ -1,11 +1,11 @@
 """tumble: rigid-body physics for Python.
 
-    >>> import tumble
-    >>> world = tumble.World()
-    >>> ball = world.add_body(tumble.Sphere(0.1), density=1000.0, position=(0.0, 0.0, 1.0))
-    >>> world.step(0.01)
-    >>> round(float(ball.velocity[2]), 4)
-    -0.0981
+>>> import tumble
+>>> world = tumble.World()
+>>> ball = world.add_body(tumble.Sphere(0.1), density=1000.0, position=(0.0, 0.0, 1.0))
+>>> world.step(0.01)
+>>> round(float(ball.velocity[2]), 4)
+-0.0981
 """
 
 from __future__ import annotations

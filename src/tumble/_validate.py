@@ -28,7 +28,12 @@ def _show(value) -> str:
 
 def as_float(name: str, value, *, positive: bool = False, nonnegative: bool = False) -> float:
     """A finite real scalar; ``positive``/``nonnegative`` add a sign check."""
-    if type(value) is float and math.isfinite(value) and (value > 0.0 or not positive) and (value >= 0.0 or not nonnegative):
+    if (
+        type(value) is float
+        and math.isfinite(value)
+        and (value > 0.0 or not positive)
+        and (value >= 0.0 or not nonnegative)
+    ):
         return value  # the common case, kept cheap for World.step
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
         if not (isinstance(value, np.ndarray) and value.shape == () and np.issubdtype(value.dtype, np.number)):
@@ -91,9 +96,7 @@ def as_rotation(name: str, value) -> np.ndarray:
 def mass_or_density(mass, density) -> tuple[str, float]:
     """Exactly one of ``mass=`` or ``density=``, positive and finite: returns ``("mass"|"density", value)``."""
     if (mass is None) == (density is None):
-        raise TypeError(
-            f"give exactly one of mass= or density=, got mass={_show(mass)} and density={_show(density)}"
-        )
+        raise TypeError(f"give exactly one of mass= or density=, got mass={_show(mass)} and density={_show(density)}")
     if mass is not None:
         return "mass", as_float("mass", mass, positive=True)
     return "density", as_float("density", density, positive=True)

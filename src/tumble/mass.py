@@ -65,16 +65,12 @@ def _check_inertia(inertia) -> np.ndarray:
     scale = float(np.max(np.abs(tensor)))
     asymmetry = float(np.max(np.abs(tensor - tensor.T)))
     if asymmetry > _SYMMETRY_RTOL * scale:
-        raise ValueError(
-            f"inertia must be symmetric, got {_show(tensor)} (largest |I - Iᵀ| entry {asymmetry:.3g})"
-        )
+        raise ValueError(f"inertia must be symmetric, got {_show(tensor)} (largest |I - Iᵀ| entry {asymmetry:.3g})")
     tensor = 0.5 * (tensor + tensor.T)
     moments = np.linalg.eigvalsh(tensor)
     trace = float(np.trace(tensor))
     if moments[0] < -_PSD_RTOL * abs(trace) or trace < 0.0:
-        raise ValueError(
-            f"inertia must be positive semi-definite, got eigenvalues {_show(moments)} of {_show(tensor)}"
-        )
+        raise ValueError(f"inertia must be positive semi-definite, got eigenvalues {_show(moments)} of {_show(tensor)}")
     if moments[0] + moments[1] < moments[2] - _TRIANGLE_RTOL * trace:
         raise ValueError(
             "inertia violates the triangle inequality I1 + I2 >= I3 of its principal moments "
@@ -236,17 +232,10 @@ class MassProperties:
             scale = max(float(np.max(np.abs(a))), float(np.max(np.abs(b))))
             return bool(np.max(np.abs(a - b)) <= atol + rtol * scale)
 
-        return (
-            close(self._mass, other._mass)
-            and close(self._com, other._com)
-            and close(self._inertia, other._inertia)
-        )
+        return close(self._mass, other._mass) and close(self._com, other._com) and close(self._inertia, other._inertia)
 
     def __repr__(self) -> str:
-        return (
-            f"MassProperties(mass={self._mass!r}, com={self._com.tolist()!r}, "
-            f"inertia={self._inertia.tolist()!r})"
-        )
+        return f"MassProperties(mass={self._mass!r}, com={self._com.tolist()!r}, inertia={self._inertia.tolist()!r})"
 
 
 # --- constructors --------------------------------------------------------------------------------------
@@ -364,9 +353,7 @@ def capsule(radius, length, *, mass=None, density=None) -> MassProperties:
     m_c = m * cylinder_volume / volume
     m_h = m * hemisphere_volume / volume
     axial = 0.5 * m_c * r * r + 0.8 * m_h * r * r
-    side = m_c * (3.0 * r * r + length_**2) / 12.0 + 2.0 * m_h * (
-        0.4 * r * r + 0.25 * length_**2 + 0.375 * length_ * r
-    )
+    side = m_c * (3.0 * r * r + length_**2) / 12.0 + 2.0 * m_h * (0.4 * r * r + 0.25 * length_**2 + 0.375 * length_ * r)
     return _diagonal(m, [side, side, axial])
 
 
@@ -430,9 +417,7 @@ def _mesh_arrays(vertices, faces) -> tuple[np.ndarray, np.ndarray]:
             f"faces index vertices out of range 0..{verts.shape[0] - 1}: {bad.size} faces, "
             f"e.g. face {bad[0]} = {tris[bad[0]].tolist()}"
         )
-    repeated = np.flatnonzero(
-        (tris[:, 0] == tris[:, 1]) | (tris[:, 1] == tris[:, 2]) | (tris[:, 2] == tris[:, 0])
-    )
+    repeated = np.flatnonzero((tris[:, 0] == tris[:, 1]) | (tris[:, 1] == tris[:, 2]) | (tris[:, 2] == tris[:, 0]))
     if repeated.size:
         raise ValueError(
             f"faces must be triangles of three distinct vertices (degenerate): {repeated.size} faces repeat "
@@ -454,8 +439,7 @@ def _edge_problem(faces: np.ndarray) -> str | None:
     boundary = keys[counts == 1]
     if boundary.size:
         return (
-            f"is not closed: {len(boundary)} boundary edges are used by only one face, "
-            f"e.g. edge {boundary[0].tolist()}"
+            f"is not closed: {len(boundary)} boundary edges are used by only one face, e.g. edge {boundary[0].tolist()}"
         )
     shared = keys[counts > 2]
     if shared.size:

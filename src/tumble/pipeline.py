@@ -35,7 +35,16 @@ def simulate_steps(
     """Advance ``n_steps`` steps of ``h``; returns ``(steps_done, failing_body)`` (-1 when all went well)."""
     method = params.resolve_integrator(model.has_constraints)
     steps_done, failing_body = advance_free_bodies(
-        model, state, inputs.body_force, inputs.body_torque, scratch, h, n_steps, method, recording, record_every
+        model,
+        state,
+        inputs.body_force,
+        inputs.body_torque,
+        scratch,
+        h,
+        n_steps,
+        method,
+        recording,
+        record_every,
     )
     state.step_count += steps_done
     # Accumulate time step by step so that simulate(n steps) and n calls of step() agree bit for bit.

@@ -84,9 +84,7 @@ def _nonzero_norm(name: str, q: np.ndarray) -> np.ndarray:
     bad = norm < _MIN_QUAT_NORM
     if np.any(bad):
         first = q[tuple(np.argwhere(bad)[0])] if bad.ndim else q
-        raise ValueError(
-            f"{name} must be a non-zero quaternion [w, x, y, z], got {_show(first)}{_where(bad)}"
-        )
+        raise ValueError(f"{name} must be a non-zero quaternion [w, x, y, z], got {_show(first)}{_where(bad)}")
     return norm
 
 
@@ -300,9 +298,7 @@ def quat_to_axis_angle(q) -> tuple[np.ndarray, np.ndarray]:
     length = np.linalg.norm(u, axis=-1)
     angle = 2.0 * np.arctan2(length, q[..., 0])
     identity = length == 0.0
-    axis = np.where(
-        identity[..., None], np.array([1.0, 0.0, 0.0]), u / np.where(identity, 1.0, length)[..., None]
-    )
+    axis = np.where(identity[..., None], np.array([1.0, 0.0, 0.0]), u / np.where(identity, 1.0, length)[..., None])
     return axis, angle
 
 
@@ -605,8 +601,7 @@ def from_scipy(rotation: Rotation) -> np.ndarray:
     """
     if not isinstance(rotation, Rotation):
         raise TypeError(
-            f"rotation must be a scipy.spatial.transform.Rotation, got {_show(rotation)} "
-            f"({type(rotation).__name__})"
+            f"rotation must be a scipy.spatial.transform.Rotation, got {_show(rotation)} ({type(rotation).__name__})"
         )
     xyzw = np.asarray(rotation.as_quat(), dtype=np.float64)
     return _positive_w(xyzw[..., [3, 0, 1, 2]])

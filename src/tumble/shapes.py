@@ -347,9 +347,7 @@ class Plane(Shape):
 def _hull_extent_check(points: np.ndarray) -> float:
     size = float(np.max(points.max(axis=0) - points.min(axis=0)))
     if not size > 0.0:
-        raise ValueError(
-            f"points must span a volume, got {len(points)} copies of one point {points[0].tolist()}"
-        )
+        raise ValueError(f"points must span a volume, got {len(points)} copies of one point {points[0].tolist()}")
     return size
 
 
@@ -367,9 +365,7 @@ class ConvexHull(Shape):
     def __init__(self, points) -> None:
         pts = as_array("points", points, (3,), batch=True)
         if pts.ndim != 2 or pts.shape[0] < 4:
-            raise ValueError(
-                f"points must have shape (n, 3) with n >= 4 to span a volume, got shape {pts.shape}"
-            )
+            raise ValueError(f"points must have shape (n, 3) with n >= 4 to span a volume, got shape {pts.shape}")
         size = _hull_extent_check(pts)
         try:
             hull = scipy.spatial.ConvexHull(pts)

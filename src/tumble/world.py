@@ -47,8 +47,7 @@ def _shape_items(shape, friction: float, restitution: float) -> list[ShapeSpec]:
         return [ShapeSpec(shape, np.zeros(3), _IDENTITY.copy(), friction, restitution)]
     if not isinstance(shape, Sequence) or isinstance(shape, str) or len(shape) == 0:
         raise TypeError(
-            "shape must be a Shape, a non-empty list of (shape, position[, orientation]) or None, "
-            f"got {shape!r}"
+            f"shape must be a Shape, a non-empty list of (shape, position[, orientation]) or None, got {shape!r}"
         )
     items = []
     for k, item in enumerate(shape):
@@ -294,9 +293,7 @@ class World:
         """
         dt = as_float("dt", dt, positive=True)
         self._sync()
-        steps_done, failing = simulate_steps(
-            self._model, self._state, self._inputs, self._params, self._scratch, dt
-        )
+        steps_done, failing = simulate_steps(self._model, self._state, self._inputs, self._params, self._scratch, dt)
         if failing >= 0:
             raise self._simulation_error(failing)
 
@@ -317,7 +314,14 @@ class World:
         t0, initial = self._state.time, self._state.copy()
         recording = Trajectory.allocate_recording(self._state.body_count, n_steps // record_every)
         steps_done, failing = simulate_steps(
-            self._model, self._state, self._inputs, self._params, self._scratch, dt, n_steps, recording,
+            self._model,
+            self._state,
+            self._inputs,
+            self._params,
+            self._scratch,
+            dt,
+            n_steps,
+            recording,
             int(record_every),
         )
         frames = steps_done // record_every

@@ -108,9 +108,7 @@ def test_explicit_euler_gains_energy_as_the_course_warns():
     assert traj.total_energy[-1] > traj.total_energy[0] * (1 + 5e-5)  # measured +8e-5 over 2 s
 
 
-@pytest.mark.parametrize(
-    ("integrator", "order"), [("euler", 1), ("symplectic", 1), ("midpoint", 2), ("rk4", 4)]
-)
+@pytest.mark.parametrize(("integrator", "order"), [("euler", 1), ("symplectic", 1), ("midpoint", 2), ("rk4", 4)])
 def test_integrators_converge_at_their_order(integrator, order):
     q0 = np.array([1.0, 0.0, 0.0, 0.0])
     w0 = np.array([0.4, 1.0, -0.6])
@@ -167,7 +165,10 @@ def test_projectile_is_exact_for_rk4_and_midpoint_and_matches_the_discrete_euler
     g = np.array([0.0, 0.0, -9.81])
     x0, v0, h, n = np.array([0.0, 0.0, 1.0]), np.array([3.0, 1.0, 8.0]), 1e-2, 150
     t = n * h
-    for exact in ("rk4", "midpoint"):  # RK4 and the kick-drift-kick midpoint integrate a constant force exactly
+    for exact in (
+        "rk4",
+        "midpoint",
+    ):  # RK4 and the kick-drift-kick midpoint integrate a constant force exactly
         world = tumble.World(integrator=exact)
         body = world.add_body(tumble.Sphere(0.1), mass=1.0, position=x0, velocity=v0)
         world.simulate(n * h, h)

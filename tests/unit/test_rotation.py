@@ -174,9 +174,7 @@ def test_rotvec_log_is_inverse_of_exp_for_large_and_negative_w():
     np.testing.assert_allclose(rot.quat_to_rotvec(-q), rotvec, atol=8 * EPS)  # measured 2.2e-16
     # Beyond π the logarithm wraps to the shorter rotation about the opposite axis.
     e = unit([1.0, 1.0, 0.0])
-    np.testing.assert_allclose(
-        rot.quat_to_rotvec(rot.quat_from_rotvec(4.0 * e)), (4.0 - 2 * np.pi) * e, atol=8 * EPS
-    )
+    np.testing.assert_allclose(rot.quat_to_rotvec(rot.quat_from_rotvec(4.0 * e)), (4.0 - 2 * np.pi) * e, atol=8 * EPS)
 
 
 def test_tiny_rotvec_keeps_relative_precision():
@@ -245,9 +243,7 @@ def test_matrix_to_quat_near_half_turn_keeps_precision():
     assert np.max(sign_free_error(q_back, q)) <= 4 * EPS  # measured 1.1e-16
     # Near identity (the trace branch) the vector part is only as good as the matrix entries: absolute 1e-16.
     q = rot.quat_from_axis_angle(axes, 1e-6)
-    assert (
-        np.max(sign_free_error(rot.matrix_to_quat(rot.quat_to_matrix(q)), q)) <= 2 * EPS
-    )  # measured 1.1e-16
+    assert np.max(sign_free_error(rot.matrix_to_quat(rot.quat_to_matrix(q)), q)) <= 2 * EPS  # measured 1.1e-16
 
 
 def test_matrix_to_quat_returns_nonnegative_w():
@@ -398,9 +394,7 @@ def test_orthonormalize_repairs_a_drifted_rotation():
     R = rot.quat_to_matrix(random_quats(50, seed=27))
     drifted = R + 1e-4 * np.random.default_rng(28).normal(size=R.shape)
     fixed = rot.orthonormalize(drifted)
-    np.testing.assert_allclose(
-        np.swapaxes(fixed, -1, -2) @ fixed, np.broadcast_to(np.eye(3), R.shape), atol=8 * EPS
-    )
+    np.testing.assert_allclose(np.swapaxes(fixed, -1, -2) @ fixed, np.broadcast_to(np.eye(3), R.shape), atol=8 * EPS)
     np.testing.assert_allclose(np.linalg.det(fixed), 1.0, atol=8 * EPS)
     # The repair moves each entry by about the drift (1e-4 noise, measured 2.8e-4 max): close to R again.
     np.testing.assert_allclose(fixed, R, atol=2e-3)
@@ -537,9 +531,7 @@ def test_scipy_interop_round_trip():
     single = rot.to_scipy([0.0, 0.0, 0.0, 1.0])
     assert single.single
     np.testing.assert_allclose(single.as_rotvec(), [0.0, 0.0, np.pi], atol=2 * EPS)
-    np.testing.assert_allclose(
-        rot.from_scipy(Rotation.from_rotvec([0.0, 0.0, 0.2])), [np.cos(0.1), 0, 0, np.sin(0.1)]
-    )
+    np.testing.assert_allclose(rot.from_scipy(Rotation.from_rotvec([0.0, 0.0, 0.2])), [np.cos(0.1), 0, 0, np.sin(0.1)])
 
 
 # --- input checking ------------------------------------------------------------------------------------
@@ -562,9 +554,7 @@ ZERO = [0.0, 0.0, 0.0, 0.0]
     ],
 )
 def test_zero_quaternion_is_refused(call, name):
-    with pytest.raises(
-        ValueError, match=rf"^{name} must be a non-zero quaternion .*\[0\.0, 0\.0, 0\.0, 0\.0\]"
-    ):
+    with pytest.raises(ValueError, match=rf"^{name} must be a non-zero quaternion .*\[0\.0, 0\.0, 0\.0, 0\.0\]"):
         call()
 
 
