@@ -10,6 +10,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .geometry.packing import pack_geometry
 from .mass import MassProperties
 from .model import Model
 
@@ -73,7 +74,6 @@ class ModelBuilder:
         is_dynamic = mass > 0.0
         inv_mass = np.divide(1.0, mass, out=np.zeros(n), where=is_dynamic)
         specs = [(i, s) for i, row in enumerate(self.rows) for s in row.shapes]
-        shape_count = len(specs)
         return Model(
             gravity=np.array(gravity, dtype=np.float64),
             body_mass=mass,
@@ -85,11 +85,12 @@ class ModelBuilder:
             body_linear_damping=np.array([r.linear_damping for r in self.rows], dtype=np.float64),
             body_angular_damping=np.array([r.angular_damping for r in self.rows], dtype=np.float64),
             body_name=tuple(r.name for r in self.rows),
-            shape_body=np.array([i for i, _ in specs], dtype=np.int64),
-            shape_type=np.array([int(s.shape.type) for _, s in specs], dtype=np.int64),
-            shape_params=np.array([s.shape.params for _, s in specs], dtype=np.float64).reshape(shape_count, 4),
-            shape_pos_local=np.array([s.position - com[i] for i, s in specs], dtype=np.float64).reshape(-1, 3),
-            shape_quat_local=np.array([s.quat for _, s in specs], dtype=np.float64).reshape(-1, 4),
+            geometry=pack_geometry(
+                [s.shape for _, s in specs],
+                [i for i, _ in specs],
+                np.array([s.position - com[i] for i, s in specs], dtype=np.float64).reshape(-1, 3),
+                np.array([s.quat for _, s in specs], dtype=np.float64).reshape(-1, 4),
+            ),
             shape_friction=np.array([s.friction for _, s in specs], dtype=np.float64),
             shape_restitution=np.array([s.restitution for _, s in specs], dtype=np.float64),
             shapes=tuple(s.shape for _, s in specs),

@@ -12,6 +12,8 @@ from typing import NamedTuple
 
 import numpy as np
 
+from .geometry.packing import GeometryArrays
+
 __all__ = ["Model", "BodyArrays"]
 
 
@@ -41,11 +43,9 @@ class Model:
         body_is_dynamic: (body_count,) bool.
         body_linear_damping, body_angular_damping: (body_count,) float64 [1/s].
         body_name: body names (``None`` where unnamed), in row order.
-        shape_body: (shape_count,) int64, the body row each shape belongs to.
-        shape_type: (shape_count,) int64, :class:`~tumble.shapes.ShapeType` codes.
-        shape_params: (shape_count, 4) float64, per-type sizes (see ``Shape.params``).
-        shape_pos_local: (shape_count, 3) float64 [m], shape origin relative to the body COM, body frame.
-        shape_quat_local: (shape_count, 4) float64, shape orientation in the body frame.
+        geometry: every shape packed for the collision kernels (:class:`~tumble.geometry.packing.GeometryArrays`);
+            ``model.shape_body``, ``shape_type``, ``shape_params``, ``shape_pos_local`` and ``shape_quat_local``
+            read from it.
         shape_friction, shape_restitution: (shape_count,) float64.
         shapes: the shape objects, in row order (for geometry that does not fit the arrays).
     """
@@ -60,11 +60,7 @@ class Model:
     body_linear_damping: np.ndarray
     body_angular_damping: np.ndarray
     body_name: tuple
-    shape_body: np.ndarray
-    shape_type: np.ndarray
-    shape_params: np.ndarray
-    shape_pos_local: np.ndarray
-    shape_quat_local: np.ndarray
+    geometry: GeometryArrays
     shape_friction: np.ndarray
     shape_restitution: np.ndarray
     shapes: tuple
@@ -75,7 +71,27 @@ class Model:
 
     @property
     def shape_count(self) -> int:
-        return int(self.shape_body.shape[0])
+        return int(self.geometry.shape_body.shape[0])
+
+    @property
+    def shape_body(self) -> np.ndarray:
+        return self.geometry.shape_body
+
+    @property
+    def shape_type(self) -> np.ndarray:
+        return self.geometry.shape_type
+
+    @property
+    def shape_params(self) -> np.ndarray:
+        return self.geometry.shape_params
+
+    @property
+    def shape_pos_local(self) -> np.ndarray:
+        return self.geometry.shape_pos_local
+
+    @property
+    def shape_quat_local(self) -> np.ndarray:
+        return self.geometry.shape_quat_local
 
     @cached_property
     def body_arrays(self) -> BodyArrays:
