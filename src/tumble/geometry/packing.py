@@ -31,8 +31,8 @@ class GeometryArrays(NamedTuple):
             (``inf`` for planes).
         vertex_local: (V, 3) float64 [m], hull and mesh vertices in their shape frame.
         shape_vertex_start, shape_vertex_count: (n,) int64 ranges into ``vertex_local``.
-        face_loop: (L,) int64 global vertex indices; each face is ``face_loop[face_loop_start[f]:][:face_loop_count[f]]``,
-            counter-clockwise seen from outside.
+        face_loop: (L,) int64 global vertex indices; face ``f`` is the ``face_loop_count[f]`` entries from
+            ``face_loop_start[f]``, counter-clockwise seen from outside.
         face_loop_start, face_loop_count: (F,) int64.
         face_normal: (F, 3) float64, outward unit normals in the shape frame.
         face_offset: (F,) float64 [m], ``n · x`` of the face plane in the shape frame.
