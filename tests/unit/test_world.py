@@ -147,15 +147,19 @@ def test_runs_are_bit_identical_and_simulate_equals_repeated_steps(integrator):
     assert a.state.digest() == b.state.digest() == c.state.digest()
 
 
-def test_parallel_and_serial_kernels_agree_bit_for_bit():
+def test_threaded_and_single_threaded_runs_agree_bit_for_bit(monkeypatch):
     from tumble.dynamics import integrate
 
-    big, small = _scene(), _scene()
-    big.simulate(0.5, 1e-3)  # 50 bodies x 500 steps: above PARALLEL_MIN_WORK, runs in parallel
-    assert 50 * 500 >= integrate.PARALLEL_MIN_WORK
+    threaded, single = _scene(), _scene()
+    monkeypatch.setattr(integrate, "PARALLEL_MIN_WORK", 1)
+    monkeypatch.setattr(integrate, "_THREADS", 2)
+    threaded.simulate(0.5, 1e-3)  # split into two blocks of rows, one per thread
     for _ in range(500):
-        small.step(1e-3)  # serial kernel
-    assert big.state.digest() == small.state.digest()
+        single.step(1e-3)  # threaded too, one step at a time
+    monkeypatch.setattr(integrate, "_THREADS", 1)
+    again = _scene()
+    again.simulate(0.5, 1e-3)
+    assert threaded.state.digest() == single.state.digest() == again.state.digest()
 
 
 def test_non_finite_step_raises_and_keeps_the_last_good_state():

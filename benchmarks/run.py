@@ -1,0 +1,642 @@
+"""tumble's benchmarks against MuJoCo (issue 2).
+
+Run from the repository root:
+
+    python -m benchmarks.run [--quick] [--only NAME] [--csv [DIR]] [--repeat N] [--machine NAME]
+
+``tumbling``     one body, I = diag(1, 2, 3), ω₀ = (0.01, 5, 0.01), no gravity, 20 000 steps of 1 ms: steps/s and
+                 the drift of energy and angular momentum, per integrator, tumble and MuJoCo side by side.
+``many_bodies``  4096 free spheres under gravity in one world, no collisions: body-steps per second.
+``cold_start``   ``import tumble`` and the first ``step``/``simulate`` in a fresh process, Numba cache cold
+                 and warm.
+
+Every timing is the best of ``--repeat`` runs after a first call that is reported apart (it includes the
+JIT compile or the load from Numba's disk cache). Both engines run in the same process, so compare the
+ratios, not the absolute figures, across machines. ``--csv`` writes ``DIR/<machine>/<name>.csv`` (DIR
+defaults to ``benchmarks/results``) plus ``machine.csv`` with the commit, versions, CPU and thread count.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import json
+import math
+import os
+import platform
+import socket
+import subprocess
+import sys
+import tempfile
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+import numba
+import numpy as np
+
+import tumble
+
+from . import peers
+
+__all__ = [
+    "BENCHMARKS",
+    "FULL",
+    "QUICK",
+    "Sizes",
+    "bench_cold_start",
+    "bench_many_bodies",
+    "bench_tumbling",
+    "check_targets",
+    "cold_start_script",
+    "format_table",
+    "machine_info",
+    "main",
+]
+
+REPO = Path(__file__).resolve().parent.parent
+DT = 1e-3
+INERTIA = (1.0, 2.0, 3.0)
+OMEGA0 = (0.01, 5.0, 0.01)
+TUMBLE_INTEGRATORS = ("auto", "rk4", "symplectic", "euler")
+MUJOCO_INTEGRATORS = ("Euler", "RK4")
+SEED = 0
+
+
+@dataclass(frozen=True)
+class Sizes:
+    """How big each benchmark is; :data:`FULL` for the report, :data:`QUICK` for the smoke test."""
+
+    tumbling_steps: int = 20_000
+    record_every: int = 100
+    bodies: int = 4096
+    body_steps: int = 1000
+    mujoco_seconds: float = 2.0  # wall time of one timed MuJoCo run in ``many_bodies``
+    repeat: int = 7
+    cold_start: bool = True
+    cold_start_bodies: int = 64
+
+
+FULL = Sizes()
+QUICK = Sizes(
+    tumbling_steps=200, record_every=100, bodies=64, body_steps=50, mujoco_seconds=0.02, repeat=1,
+    cold_start=False, cold_start_bodies=8,
+)  # fmt: skip
+
+
+def _timed(function: Callable, *args, **kwargs) -> tuple[float, object]:
+    start = time.perf_counter()
+    result = function(*args, **kwargs)
+    return time.perf_counter() - start, result
+
+
+# --- machine -----------------------------------------------------------------------------------------
+
+
+def _commit() -> str:
+    try:
+        out = subprocess.run(
+            ["git", "rev-parse", "--short", "HEAD"], cwd=REPO, capture_output=True, text=True, timeout=10
+        )
+    except (OSError, subprocess.SubprocessError):
+        return "unknown"
+    return out.stdout.strip() or "unknown"
+
+
+def _cpu_model() -> str:
+    try:
+        with open("/proc/cpuinfo") as f:
+            for line in f:
+                if line.startswith("model name"):
+                    return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return platform.processor() or platform.machine() or "unknown"
+
+
+def _mujoco_version() -> str:
+    try:
+        import mujoco
+    except ImportError:
+        return "not installed"
+    return mujoco.__version__
+
+
+def machine_info() -> dict[str, object]:
+    """Commit, versions, CPU and threads: what a result depends on."""
+    try:
+        usable = len(os.sched_getaffinity(0))
+    except AttributeError:
+        usable = os.cpu_count()
+    return {
+        "commit": _commit(),
+        "date": time.strftime("%Y-%m-%d %H:%M:%S %Z"),
+        "host": socket.gethostname() or "local",
+        "cpu": _cpu_model(),
+        "cores": usable,
+        "numba_threads": numba.get_num_threads(),
+        "python": platform.python_version(),
+        "numpy": np.__version__,
+        "numba": numba.__version__,
+        "mujoco": _mujoco_version(),
+        "tumble": tumble.__version__,
+    }
+
+
+# --- measurements shared by both engines -------------------------------------------------------------
+
+
+def _drifts(quat: np.ndarray, omega_body: np.ndarray) -> tuple[float, float]:
+    """``(max|E − E0|/E0, max|L − L0|/|L0|)`` of the tumbling body from frames (T, 4) and (T, 3).
+
+    The same formula for both engines: E = ½ ωᵀ I ω from the body-frame spin, L = R I ω in the world frame.
+    """
+    energy = peers.rotational_energy(INERTIA, omega_body)
+    angmom = peers.angular_momentum_world(quat, INERTIA, omega_body)
+    e_drift = float(np.max(np.abs(energy - energy[0])) / energy[0])
+    l_drift = float(np.max(np.linalg.norm(angmom - angmom[0], axis=1)) / np.linalg.norm(angmom[0]))
+    return e_drift, l_drift
+
+
+def _chunks(steps: int, every: int) -> list[int]:
+    return [every] * (steps // every) + ([steps % every] if steps % every else [])
+
+
+# --- 1. tumbling body --------------------------------------------------------------------------------
+
+
+def _tumbling_world(integrator: str) -> tumble.World:
+    world = tumble.World(gravity=(0.0, 0.0, 0.0), integrator=integrator)
+    world.add_body(None, mass=1.0, inertia=np.diag(INERTIA), angular_velocity=OMEGA0)
+    world.state  # build the model now, outside the timed region  # noqa: B018
+    return world
+
+
+def _tumble_simulate(integrator: str, sizes: Sizes) -> dict:
+    steps, every = sizes.tumbling_steps, sizes.record_every
+    # The first call has the timed call's size: a long run of one body takes the parallel kernel.
+    first, _ = _timed(_tumbling_world(integrator).simulate, steps * DT, DT, record_every=every)
+    best = math.inf
+    for _ in range(sizes.repeat):
+        world = _tumbling_world(integrator)
+        elapsed, traj = _timed(world.simulate, steps * DT, DT, record_every=every)
+        best = min(best, elapsed)
+    e_drift, l_drift = _drifts(traj.orientation[:, 0], traj.angular_velocity_body()[:, 0])
+    return _tumbling_row("tumble", integrator, "simulate", steps, best, first, e_drift, l_drift)
+
+
+def _tumble_step_loop(integrator: str, sizes: Sizes) -> dict:
+    steps, every = sizes.tumbling_steps, sizes.record_every
+    first, _ = _timed(_tumbling_world(integrator).step, DT)
+    best = math.inf
+    for _ in range(sizes.repeat):
+        world = _tumbling_world(integrator)
+        body = world.bodies[0]
+        step = world.step
+        quats, omegas = [body.orientation], [body.angular_velocity_body]
+        elapsed = 0.0
+        for n in _chunks(steps, every):
+            start = time.perf_counter()
+            for _ in range(n):
+                step(DT)
+            elapsed += time.perf_counter() - start
+            quats.append(body.orientation)
+            omegas.append(body.angular_velocity_body)
+        best = min(best, elapsed)
+    e_drift, l_drift = _drifts(np.array(quats), np.array(omegas))
+    return _tumbling_row("tumble", integrator, "step() loop", steps, best, first, e_drift, l_drift)
+
+
+def _mujoco_tumbling_reset(model, data) -> None:
+    import mujoco
+
+    mujoco.mj_resetData(model, data)
+    peers.set_free_body_angvel(model, data, [OMEGA0])  # identity orientation: body frame == world frame
+
+
+def _mujoco_step_loop(integrator: str, sizes: Sizes) -> dict:
+    import mujoco
+
+    steps, every = sizes.tumbling_steps, sizes.record_every
+    model, data = peers.load(peers.tumbling_body_mjcf(integrator, DT, 1.0, INERTIA))
+    _mujoco_tumbling_reset(model, data)
+    first, _ = _timed(mujoco.mj_step, model, data)
+    best = math.inf
+    for _ in range(sizes.repeat):
+        _mujoco_tumbling_reset(model, data)
+        frames = [peers.free_body_arrays(model, data.qpos, data.qvel)]
+        elapsed = 0.0
+        for n in _chunks(steps, every):
+            start = time.perf_counter()
+            for _ in range(n):
+                mujoco.mj_step(model, data)
+            elapsed += time.perf_counter() - start
+            frames.append(peers.free_body_arrays(model, data.qpos, data.qvel))
+        best = min(best, elapsed)
+    quat = np.array([f[0][0] for f in frames])
+    omega = np.array([f[1][0] for f in frames])
+    e_drift, l_drift = _drifts(quat, omega)
+    return _tumbling_row("MuJoCo", integrator, "mj_step loop", steps, best, first, e_drift, l_drift)
+
+
+def _mujoco_rollout(integrator: str, sizes: Sizes) -> dict | None:
+    """The whole run in one call of MuJoCo's C rollout (the fair match for ``world.simulate``)."""
+    import mujoco
+
+    try:
+        from mujoco import rollout
+    except ImportError:
+        return None
+    steps, every = sizes.tumbling_steps, sizes.record_every
+    model, data = peers.load(peers.tumbling_body_mjcf(integrator, DT, 1.0, INERTIA))
+    spec = mujoco.mjtState.mjSTATE_FULLPHYSICS
+    _mujoco_tumbling_reset(model, data)
+    initial = np.empty((1, mujoco.mj_stateSize(model, spec)))
+    mujoco.mj_getState(model, data, initial[0], spec)
+    out = np.empty((1, steps, initial.shape[1]))
+    first, _ = _timed(rollout.rollout, model, data, initial, nstep=steps, state=out)
+    best = math.inf
+    for _ in range(sizes.repeat):
+        elapsed, _ = _timed(rollout.rollout, model, data, initial, nstep=steps, state=out)
+        best = min(best, elapsed)
+    # Row k of ``out`` is the state after k + 1 steps; read every ``every``-th back through an MjData.
+    scratch = mujoco.MjData(model)
+    frames = []
+    for row in [initial[0], *out[0, every - 1 :: every]]:
+        mujoco.mj_setState(model, scratch, row, spec)
+        frames.append(peers.free_body_arrays(model, scratch.qpos, scratch.qvel))
+    quat = np.array([f[0][0] for f in frames])
+    omega = np.array([f[1][0] for f in frames])
+    e_drift, l_drift = _drifts(quat, omega)
+    return _tumbling_row("MuJoCo", integrator, "rollout", steps, best, first, e_drift, l_drift)
+
+
+def _tumbling_row(engine, integrator, mode, steps, seconds, first, e_drift, l_drift) -> dict:
+    return {
+        "engine": engine,
+        "integrator": integrator,
+        "mode": mode,
+        "steps": steps,
+        "steps_per_s": steps / seconds,
+        "us_per_step": 1e6 * seconds / steps,
+        "first_call_ms": 1e3 * first,
+        "energy_drift": e_drift,
+        "angmom_drift": l_drift,
+    }
+
+
+def bench_tumbling(sizes: Sizes = FULL) -> list[dict]:
+    """Benchmark 1: one tumbling body, every tumble integrator and MuJoCo Euler/RK4.
+
+    ``x_mujoco_rk4`` is steps/s over that of the faster of MuJoCo's two RK4 runs (rollout, mj_step loop).
+    """
+    rows = [_tumble_simulate(name, sizes) for name in TUMBLE_INTEGRATORS]
+    rows += [_tumble_step_loop(name, sizes) for name in TUMBLE_INTEGRATORS]
+    if peers.have_mujoco():
+        for name in MUJOCO_INTEGRATORS:
+            row = _mujoco_rollout(name, sizes)
+            rows += [row] if row is not None else []
+            rows.append(_mujoco_step_loop(name, sizes))
+        reference = max(r["steps_per_s"] for r in rows if r["engine"] == "MuJoCo" and r["integrator"] == "RK4")
+        for r in rows:
+            r["x_mujoco_rk4"] = r["steps_per_s"] / reference
+    return rows
+
+
+# --- 2. many free bodies -----------------------------------------------------------------------------
+
+
+def _many_bodies_world(n: int) -> tumble.World:
+    world = tumble.World()  # default gravity (0, 0, -9.81)
+    omega = peers.random_angular_velocities(n, SEED)
+    for position, w in zip(peers.grid_positions(n), omega, strict=True):
+        world.add_body(tumble.Sphere(0.05), mass=1.0, position=position, angular_velocity=w)
+    world.state  # noqa: B018
+    return world
+
+
+@dataclass
+class _Contender:
+    """One configuration of the many-bodies benchmark: ``run()`` takes ``steps`` steps and returns seconds."""
+
+    row: dict
+    run: Callable[[], float]
+    best: float = math.inf
+
+
+def _tumble_contender(world: tumble.World, integrator: str, threads: int, steps: int, build_s: float) -> _Contender:
+    def run() -> float:
+        default_threads = numba.get_num_threads()
+        world.integrator = integrator
+        numba.set_num_threads(threads)
+        try:
+            elapsed, _ = _timed(world.simulate, steps * DT, DT, record_every=steps)
+        finally:
+            numba.set_num_threads(default_threads)
+        if not np.all(np.isfinite(world.state.body_pos)):
+            raise RuntimeError(f"tumble {integrator}: non-finite positions in the many-bodies run")
+        return elapsed
+
+    row = _many_row("tumble", integrator, "no contacts", threads, world.state.body_count, steps, build_s)
+    return _Contender(row, run)
+
+
+def _mujoco_contender(sizes: Sizes, disable_contact: bool) -> _Contender:
+    import mujoco
+
+    n = sizes.bodies
+    xml = peers.free_bodies_mjcf(peers.grid_positions(n), integrator="Euler", timestep=DT,
+                                 disable_contact=disable_contact)  # fmt: skip
+    build_s, (model, data) = _timed(peers.load, xml)
+    peers.set_free_body_angvel(model, data, peers.random_angular_velocities(n, SEED))
+    probe, _ = _timed(lambda: [mujoco.mj_step(model, data) for _ in range(5)])
+    steps = max(5, round(sizes.mujoco_seconds / (probe / 5)))
+
+    def run() -> float:
+        start = time.perf_counter()
+        for _ in range(steps):
+            mujoco.mj_step(model, data)
+        elapsed = time.perf_counter() - start
+        if not np.all(np.isfinite(data.qpos)):
+            raise RuntimeError("MuJoCo: non-finite positions in the many-bodies run")
+        return elapsed
+
+    config = "contact disabled" if disable_contact else "contype=0"
+    row = _many_row("MuJoCo", "Euler", config, 1, n, steps, build_s)
+    row["first_call_s"] = probe / 5  # the first steps (MuJoCo compiles nothing at run time)
+    return _Contender(row, run)
+
+
+def _many_row(engine, integrator, config, threads, bodies, steps, build_s) -> dict:
+    return {
+        "engine": engine,
+        "integrator": integrator,
+        "config": config,
+        "threads": threads,
+        "bodies": bodies,
+        "steps": steps,
+        "build_s": build_s,
+    }
+
+
+def bench_many_bodies(sizes: Sizes = FULL) -> list[dict]:
+    """Benchmark 2: ``sizes.bodies`` free spheres under gravity in one world, random spins (same seed).
+
+    The configurations take turns, round after round (best of ``min(repeat, 5)`` rounds), so that load from
+    other processes falls on all of them alike. tumble runs ``body_steps`` steps per call, MuJoCo about
+    ``mujoco_seconds`` of wall time. ``x_mujoco`` is body-steps/s over MuJoCo's (Euler, ``contype=0``; MuJoCo
+    steps on one thread). The tumble world keeps falling from one call to the next.
+    """
+    build_s, world = _timed(_many_bodies_world, sizes.bodies)
+    threads = numba.get_num_threads()
+    contenders = [
+        _tumble_contender(world, integrator, count, sizes.body_steps, build_s)
+        for integrator in ("auto", "symplectic")
+        for count in sorted({threads, 1}, reverse=True)
+    ]
+    if peers.have_mujoco():
+        contenders += [_mujoco_contender(sizes, disable_contact=flag) for flag in (False, True)]
+    for c in contenders:
+        first = c.run()
+        c.row.setdefault("first_call_s", first)
+    for _ in range(max(1, min(sizes.repeat, 5))):
+        for c in contenders:
+            c.best = min(c.best, c.run())
+    rows = []
+    for c in contenders:
+        rows.append({**c.row, "wall_s": c.best, "body_steps_per_s": c.row["bodies"] * c.row["steps"] / c.best})
+    mujoco_rows = [r for r in rows if r["engine"] == "MuJoCo" and r["config"] == "contype=0"]
+    if mujoco_rows:
+        for r in rows:
+            r["x_mujoco"] = r["body_steps_per_s"] / mujoco_rows[0]["body_steps_per_s"]
+    return rows
+
+
+# --- 3. cold start -----------------------------------------------------------------------------------
+
+_COLD_START_SCRIPT = """
+import json, time
+start = time.perf_counter()
+import tumble
+imported = time.perf_counter()
+import numpy as np
+
+
+def first_step():
+    world = tumble.World(gravity=(0.0, 0.0, 0.0))
+    world.add_body(None, mass=1.0, inertia=np.diag([1.0, 2.0, 3.0]), angular_velocity=(0.01, 5.0, 0.01))
+    world.state
+    t = time.perf_counter()
+    world.step(1e-3)
+    return time.perf_counter() - t
+
+
+def first_simulate():
+    world = tumble.World()
+    for i in range({bodies}):
+        world.add_body(tumble.Sphere(0.05), mass=1.0, position=(0.2 * i, 0.0, 10.0), angular_velocity=(1.0, 2.0, 3.0))
+    world.state
+    t = time.perf_counter()
+    world.simulate(1.0, 1e-3, record_every=1000)
+    return time.perf_counter() - t
+
+
+times = {{"import_s": imported - start}}
+for name in {order!r}:
+    times[name + "_s"] = first_step() if name == "first_step" else first_simulate()
+print(json.dumps(times))
+"""
+
+_ORDERS = {"step first": ("first_step", "first_simulate"), "simulate first": ("first_simulate", "first_step")}
+
+
+def cold_start_script(bodies: int, order: str = "step first") -> str:
+    """The Python source a cold-start process runs; it prints its timings as one JSON line."""
+    return _COLD_START_SCRIPT.format(bodies=int(bodies), order=_ORDERS[order])
+
+
+def _cold_start_process(cache_dir: str, bodies: int, order: str = "step first") -> dict:
+    env = dict(os.environ, NUMBA_CACHE_DIR=cache_dir)
+    script = cold_start_script(bodies, order)
+    start = time.perf_counter()
+    out = subprocess.run([sys.executable, "-c", script], env=env, cwd=REPO, capture_output=True, text=True,
+                         timeout=600)  # fmt: skip
+    process_s = time.perf_counter() - start
+    if out.returncode != 0:
+        raise RuntimeError(f"cold-start subprocess failed ({out.returncode}):\n{out.stderr}")
+    result = json.loads(out.stdout.strip().splitlines()[-1])
+    result["process_s"] = process_s
+    return result
+
+
+def _cold_start_row(cache: str, order: str, r: dict) -> dict:
+    return {
+        "cache": cache,
+        "order": order,
+        "import_s": r["import_s"],
+        "first_step_s": r["first_step_s"],
+        "import_plus_step_s": r["import_s"] + r["first_step_s"],
+        "first_simulate_s": r["first_simulate_s"],
+        "process_s": r["process_s"],
+    }
+
+
+def bench_cold_start(sizes: Sizes = FULL) -> list[dict]:
+    """Benchmark 3: a fresh interpreter per run with ``NUMBA_CACHE_DIR`` a new empty directory (cold), then
+    the same directory again (warm, best of ``min(repeat, 3)``).
+
+    Each process imports tumble, takes one ``step`` of one body and one ``simulate`` of
+    ``cold_start_bodies`` bodies for 1000 steps (enough work for the parallel kernel), in that order; a last
+    cold process does the ``simulate`` first, as a script that starts with a big run would.
+    ``import_plus_step_s`` is what the targets judge.
+    """
+    bodies = sizes.cold_start_bodies
+    with tempfile.TemporaryDirectory(prefix="tumble-numba-cache-") as cache_dir:
+        cold = _cold_start_process(cache_dir, bodies)
+        warm_runs = [_cold_start_process(cache_dir, bodies) for _ in range(max(1, min(sizes.repeat, 3)))]
+    warm = min(warm_runs, key=lambda r: r["import_s"] + r["first_step_s"])
+    with tempfile.TemporaryDirectory(prefix="tumble-numba-cache-") as cache_dir:
+        cold_simulate_first = _cold_start_process(cache_dir, bodies, "simulate first")
+    return [
+        _cold_start_row("cold", "step first", cold),
+        _cold_start_row("warm", "step first", warm),
+        _cold_start_row("cold", "simulate first", cold_simulate_first),
+    ]
+
+
+# --- targets -----------------------------------------------------------------------------------------
+
+
+def _find(rows: list[dict], **match) -> dict | None:
+    for r in rows:
+        if all(r.get(k) == v for k, v in match.items()):
+            return r
+    return None
+
+
+def check_targets(results: dict[str, list[dict]]) -> list[dict]:
+    """The issue's targets, each with the measured value and whether it is met."""
+    targets = []
+
+    def add(name, value, limit, met):
+        targets.append({"target": name, "value": value, "limit": limit, "met": "yes" if met else "NO"})
+
+    tumbling = results.get("tumbling", [])
+    sim = _find(tumbling, engine="tumble", integrator="auto", mode="simulate")
+    if sim is not None:
+        if "x_mujoco_rk4" in sim:
+            add("simulate(auto) steps/s vs MuJoCo RK4 (x)", sim["x_mujoco_rk4"], ">= 2", sim["x_mujoco_rk4"] >= 2)
+        add("simulate(auto) energy drift", sim["energy_drift"], "< 1e-9", sim["energy_drift"] < 1e-9)
+        add("simulate(auto) |L| drift", sim["angmom_drift"], "< 1e-12", sim["angmom_drift"] < 1e-12)
+    step = _find(tumbling, engine="tumble", integrator="auto", mode="step() loop")
+    if step is not None:
+        add("world.step(auto) us/call", step["us_per_step"], "< 10", step["us_per_step"] < 10)
+    many = results.get("many_bodies", [])
+    threads = max((r["threads"] for r in many if r["engine"] == "tumble"), default=None)
+    for integrator in ("auto", "symplectic"):
+        row = _find(many, engine="tumble", integrator=integrator, threads=threads)
+        if row is not None and "x_mujoco" in row:
+            label = f"{row['bodies']} bodies, {integrator}, {threads} threads vs MuJoCo Euler (x)"
+            add(label, row["x_mujoco"], ">= 10", row["x_mujoco"] >= 10)
+    for row in results.get("cold_start", []):
+        if row["order"] != "step first":
+            continue
+        limit = 1.5 if row["cache"] == "warm" else 20.0
+        add(f"{row['cache']} start: import + first step (s)", row["import_plus_step_s"], f"< {limit:g}",
+            row["import_plus_step_s"] < limit)  # fmt: skip
+    return targets
+
+
+# --- output ------------------------------------------------------------------------------------------
+
+
+def _format_value(value) -> str:
+    if isinstance(value, bool) or not isinstance(value, (float, np.floating)):
+        return str(value)
+    if not math.isfinite(value):
+        return str(value)
+    magnitude = abs(value)
+    if magnitude == 0.0:
+        return "0"
+    if magnitude < 1e-3 or magnitude >= 1e9:
+        return f"{value:.2e}"
+    decimals = max(0, 3 - math.floor(math.log10(magnitude)))
+    return f"{value:,.{decimals}f}"
+
+
+def format_table(rows: list[dict]) -> str:
+    """Rows as a plain-text table: columns in first-seen order, numbers right-aligned."""
+    if not rows:
+        return "(no rows)"
+    columns = list(dict.fromkeys(k for r in rows for k in r))
+    cells = [[_format_value(r[c]) if c in r else "-" for c in columns] for r in rows]
+    widths = [max(len(c), *(len(row[i]) for row in cells)) for i, c in enumerate(columns)]
+    numeric = [all(isinstance(r.get(c, 0), (int, float, np.number)) for r in rows) for c in columns]
+
+    def line(values):
+        cells = (v.rjust(w) if num else v.ljust(w) for v, w, num in zip(values, widths, numeric, strict=True))
+        return "  ".join(cells).rstrip()
+
+    return "\n".join([line(columns), line(["-" * w for w in widths]), *(line(row) for row in cells)])
+
+
+def write_csv(path: Path, rows: list[dict]) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    columns = list(dict.fromkeys(k for r in rows for k in r))
+    with open(path, "w", newline="") as f:
+        writer = csv.DictWriter(f, fieldnames=columns)
+        writer.writeheader()
+        for r in rows:
+            writer.writerow({k: (repr(float(v)) if isinstance(v, (float, np.floating)) else v) for k, v in r.items()})
+
+
+BENCHMARKS: dict[str, Callable[[Sizes], list[dict]]] = {
+    "tumbling": bench_tumbling,
+    "many_bodies": bench_many_bodies,
+    "cold_start": bench_cold_start,
+}
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m benchmarks.run", description=__doc__.split("\n\n")[0])
+    parser.add_argument("--quick", action="store_true", help="tiny sizes, no cold start (a smoke test)")
+    parser.add_argument("--only", choices=sorted(BENCHMARKS), action="append", help="run only this benchmark")
+    parser.add_argument("--csv", nargs="?", const="benchmarks/results", metavar="DIR",
+                        help="write DIR/<machine>/<name>.csv (DIR: benchmarks/results)")  # fmt: skip
+    parser.add_argument("--repeat", type=int, help="timed repeats (best is kept)")
+    parser.add_argument("--machine", help="name of the results folder (default: the host name, else 'local')")
+    args = parser.parse_args(argv)
+
+    sizes = QUICK if args.quick else FULL
+    if args.repeat is not None:
+        sizes = Sizes(**{**sizes.__dict__, "repeat": max(1, args.repeat)})
+    names = args.only or [n for n in BENCHMARKS if sizes.cold_start or n != "cold_start"]
+
+    info = machine_info()
+    print("machine:", ", ".join(f"{k}={v}" for k, v in info.items()), flush=True)
+    results: dict[str, list[dict]] = {}
+    for name in names:
+        print(f"\n== {name} ==", flush=True)
+        elapsed, rows = _timed(BENCHMARKS[name], sizes)
+        results[name] = rows
+        print(format_table(rows))
+        print(f"({elapsed:.1f} s)", flush=True)
+    targets = check_targets(results)
+    if targets:
+        print("\n== targets ==")
+        print(format_table(targets))
+
+    if args.csv is not None:
+        folder = Path(args.csv) / (args.machine or info["host"] or "local")
+        for name, rows in results.items():
+            write_csv(folder / f"{name}.csv", rows)
+        if targets:
+            write_csv(folder / "targets.csv", targets)
+        write_csv(folder / "machine.csv", [{"key": k, "value": v} for k, v in info.items()])
+        print(f"\nwrote {folder}/")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,110 @@
+"""The benchmarks run on tiny sizes and return finite rows, so they never rot. Nothing here asserts on timings."""
+
+from __future__ import annotations
+
+import math
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import tumble
+
+REPO = Path(__file__).resolve().parent.parent
+if str(REPO) not in sys.path:
+    sys.path.insert(0, str(REPO))
+
+from benchmarks import peers, run  # noqa: E402
+
+TINY = run.Sizes(
+    tumbling_steps=40, record_every=10, bodies=8, body_steps=5, mujoco_seconds=0.002, repeat=1,
+    cold_start=False, cold_start_bodies=2,
+)  # fmt: skip
+
+
+def _assert_finite_numbers(rows: list[dict]) -> None:
+    assert rows
+    for row in rows:
+        for key, value in row.items():
+            if isinstance(value, (int, float, np.number)) and not isinstance(value, bool):
+                assert math.isfinite(value), f"{key} = {value} in {row}"
+
+
+def test_tumbling_rows_for_every_tumble_integrator():
+    rows = run.bench_tumbling(TINY)
+    _assert_finite_numbers(rows)
+    tumble_rows = [r for r in rows if r["engine"] == "tumble"]
+    assert {(r["integrator"], r["mode"]) for r in tumble_rows} == {
+        (name, mode) for name in run.TUMBLE_INTEGRATORS for mode in ("simulate", "step() loop")
+    }
+    for r in tumble_rows:
+        assert r["steps"] == TINY.tumbling_steps
+        assert r["steps_per_s"] > 0
+
+
+def test_tumbling_rows_for_mujoco():
+    pytest.importorskip("mujoco")
+    rows = run.bench_tumbling(TINY)
+    _assert_finite_numbers(rows)
+    modes = {(r["integrator"], r["mode"]) for r in rows if r["engine"] == "MuJoCo"}
+    assert {("Euler", "mj_step loop"), ("RK4", "mj_step loop")} <= modes
+    assert all("x_mujoco_rk4" in r for r in rows)
+    # RK4 keeps the energy of a free body to round-off over 40 steps in both engines.
+    for r in rows:
+        if r["integrator"] in ("auto", "rk4", "RK4"):
+            assert r["energy_drift"] < 1e-9
+
+
+def test_many_bodies_rows():
+    rows = run.bench_many_bodies(TINY)
+    _assert_finite_numbers(rows)
+    tumble_rows = [r for r in rows if r["engine"] == "tumble"]
+    assert {r["integrator"] for r in tumble_rows} == {"auto", "symplectic"}
+    assert 1 in {r["threads"] for r in tumble_rows}
+    assert all(r["bodies"] == TINY.bodies for r in rows)
+
+
+def test_targets_table_and_csv(tmp_path):
+    code = run.main(["--quick", "--only", "tumbling", "--csv", str(tmp_path), "--machine", "smoke"])
+    assert code == 0
+    folder = tmp_path / "smoke"
+    assert (folder / "tumbling.csv").read_text().startswith("engine,integrator,mode")
+    assert "commit" in (folder / "machine.csv").read_text()
+    rows = [{"name": "a", "value": 1.5e-12}, {"name": "bb", "value": 2_000_000.0}]
+    table = run.format_table(rows)
+    assert table.splitlines()[0].split() == ["name", "value"]
+    targets = run.check_targets({"tumbling": run.bench_tumbling(TINY)})
+    assert {t["met"] for t in targets} <= {"yes", "NO"}
+
+
+def test_cold_start_scripts_compile():
+    for order in ("step first", "simulate first"):
+        compile(run.cold_start_script(2, order), "<cold start>", "exec")
+
+
+def test_drift_measure_agrees_with_tumble_diagnostics():
+    """The benchmark's E and L formulas (used for both engines) match tumble's own Trajectory values."""
+    world = tumble.World(gravity=(0.0, 0.0, 0.0))
+    world.add_body(None, mass=1.0, inertia=np.diag(run.INERTIA), angular_velocity=run.OMEGA0)
+    traj = world.simulate(0.2, 1e-3, record_every=20)
+    omega_body = traj.angular_velocity_body()[:, 0]
+    energy = peers.rotational_energy(run.INERTIA, omega_body)
+    angmom = peers.angular_momentum_world(traj.orientation[:, 0], run.INERTIA, omega_body)
+    np.testing.assert_allclose(energy, traj.total_energy, rtol=1e-12)
+    np.testing.assert_allclose(angmom, traj.angular_momentum(), rtol=1e-12, atol=1e-12)
+
+
+def test_mujoco_free_body_angular_velocity_is_set_in_the_body_frame():
+    mujoco = pytest.importorskip("mujoco")
+    positions = peers.grid_positions(3)
+    model, data = peers.load(peers.free_bodies_mjcf(positions))
+    quat = np.array([[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [np.cos(0.4), 0.0, np.sin(0.4), 0.0]])
+    data.qpos.reshape(-1, 7)[:, 3:7] = quat
+    omega_world = peers.random_angular_velocities(3, seed=1)
+    peers.set_free_body_angvel(model, data, omega_world)
+    mujoco.mj_forward(model, data)
+    for i in range(3):
+        velocity = np.zeros(6)
+        mujoco.mj_objectVelocity(model, data, mujoco.mjtObj.mjOBJ_BODY, i + 1, velocity, 0)
+        np.testing.assert_allclose(velocity[:3], omega_world[i], atol=1e-12)
