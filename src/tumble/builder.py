@@ -26,6 +26,8 @@ class ShapeSpec:
     quat: np.ndarray  # (4,) [w, x, y, z]
     friction: float
     restitution: float
+    group: int = 1  # collision filter bits: a and b collide iff (group_a & mask_b) and (group_b & mask_a)
+    mask: int = 0xFFFFFFFF
 
 
 @dataclass
@@ -93,5 +95,29 @@ class ModelBuilder:
             ),
             shape_friction=np.array([s.friction for _, s in specs], dtype=np.float64),
             shape_restitution=np.array([s.restitution for _, s in specs], dtype=np.float64),
+            shape_group=np.array([s.group for _, s in specs], dtype=np.int64),
+            shape_mask=np.array([s.mask for _, s in specs], dtype=np.int64),
+            has_contacts=_contacts_possible(specs, is_dynamic),
             shapes=tuple(s.shape for _, s in specs),
         )
+
+
+def _contacts_possible(specs: list[tuple[int, ShapeSpec]], is_dynamic: np.ndarray) -> bool:
+    """Whether two shapes of different bodies, one of them dynamic, may pass each other's filter.
+
+    Works on the few distinct (group, mask) classes rather than on shape pairs, so it stays linear; it may
+    over-approximate when the only such pairs are between two static bodies (the broad phase skips those).
+    """
+    classes: dict[tuple[int, int], tuple[set[int], bool]] = {}
+    for i, s in specs:
+        bodies, dynamic = classes.get((s.group, s.mask), (set(), False))
+        bodies.add(i)
+        classes[(s.group, s.mask)] = (bodies, dynamic or bool(is_dynamic[i]))
+    keys = list(classes)
+    for k, (group_a, mask_a) in enumerate(keys):
+        for group_b, mask_b in keys[k:]:
+            bodies_a, dynamic_a = classes[(group_a, mask_a)]
+            bodies_b, dynamic_b = classes[(group_b, mask_b)]
+            if (group_a & mask_b) and (group_b & mask_a) and (dynamic_a or dynamic_b) and len(bodies_a | bodies_b) > 1:
+                return True
+    return False

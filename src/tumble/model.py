@@ -47,6 +47,8 @@ class Model:
             ``model.shape_body``, ``shape_type``, ``shape_params``, ``shape_pos_local`` and ``shape_quat_local``
             read from it.
         shape_friction, shape_restitution: (shape_count,) float64.
+        shape_group, shape_mask: (shape_count,) int64 collision filter bits (32 used).
+        has_contacts: whether two shapes of different bodies can touch (then the contact solver steps).
         shapes: the shape objects, in row order (for geometry that does not fit the arrays).
     """
 
@@ -63,6 +65,9 @@ class Model:
     geometry: GeometryArrays
     shape_friction: np.ndarray
     shape_restitution: np.ndarray
+    shape_group: np.ndarray
+    shape_mask: np.ndarray
+    has_contacts: bool
     shapes: tuple
 
     @property
@@ -109,4 +114,4 @@ class Model:
     @property
     def has_constraints(self) -> bool:
         """Whether anything couples bodies (contacts or joints); free-motion integrators apply if not."""
-        return False
+        return self.has_contacts

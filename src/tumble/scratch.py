@@ -2,24 +2,30 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
+from .dynamics.contact_solver import ContactRows
 from .dynamics.integrate import Recording, empty_recording
+from .geometry.manifold import MAX_POINTS, Manifolds
 
 __all__ = ["Scratch"]
 
 
 @dataclass(eq=False)
 class Scratch:
-    """Buffers sized to the body count.
+    """Buffers sized to the body count, and growable contact buffers.
 
     Attributes:
-        backup_pos, backup_quat, backup_linvel, backup_angmom: the state before the current call, kept so
-            that a failed step can be undone.
+        backup_pos, backup_quat, backup_linvel, backup_angmom: the state before the current call, kept so that a
+            failed free-motion step can be undone.
         failed_step: (body_count,) int64, the step at which each body became non-finite (-1: none).
         no_recording: zero-frame recording for calls that record nothing.
+        body_angvel: (body_count, 3) ω during a contact step [rad/s], world frame.
+        body_inv_inertia_world: (body_count, 3, 3) ``R I⁻¹ Rᵀ`` at the start of the contact step.
+        manifolds, rows, warm_normal, warm_tangent: contact buffers, grown as needed.
+        contact_count: manifolds in use after the last contact step (``World.contacts`` reads them).
     """
 
     backup_pos: np.ndarray
@@ -28,14 +34,32 @@ class Scratch:
     backup_angmom: np.ndarray
     failed_step: np.ndarray
     no_recording: Recording
+    body_angvel: np.ndarray
+    body_inv_inertia_world: np.ndarray
+    manifolds: Manifolds = field(default_factory=lambda: Manifolds.allocate(1))
+    rows: ContactRows = field(default_factory=lambda: ContactRows.allocate(1))
+    warm_normal: np.ndarray = field(default_factory=lambda: np.zeros((1, MAX_POINTS)))
+    warm_tangent: np.ndarray = field(default_factory=lambda: np.zeros((1, MAX_POINTS, 3)))
+    contact_count: int = 0
 
     @classmethod
     def for_bodies(cls, body_count: int) -> Scratch:
         return cls(
             np.zeros((body_count, 3)), np.zeros((body_count, 4)), np.zeros((body_count, 3)),
             np.zeros((body_count, 3)), np.full(body_count, -1, dtype=np.int64), empty_recording(body_count),
+            np.zeros((body_count, 3)), np.zeros((body_count, 3, 3)),
         )  # fmt: skip
 
     @property
     def backup(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         return self.backup_pos, self.backup_quat, self.backup_linvel, self.backup_angmom
+
+    def reserve_contacts(self, pair_count: int) -> None:
+        """Grow the contact buffers to hold one manifold per candidate pair (doubling, never shrinking)."""
+        capacity = self.manifolds.shape_a.shape[0]
+        if pair_count > capacity:
+            capacity = max(pair_count, 2 * capacity)
+            self.manifolds = Manifolds.allocate(capacity)
+            self.rows = ContactRows.allocate(capacity)
+            self.warm_normal = np.zeros((capacity, MAX_POINTS))
+            self.warm_tangent = np.zeros((capacity, MAX_POINTS, 3))

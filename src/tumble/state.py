@@ -1,20 +1,46 @@
 """State: what the world *is doing*. Enough to resume a run bit for bit.
 
 ``body_pos`` is the centre of mass in the world frame (the public ``Body.position`` is the body frame's
-origin, computed from it); ``body_quat`` the orientation ``[w, x, y, z]``; ``body_linvel`` the COM
-velocity; ``body_angmom`` the world-frame angular velocity.
+origin, computed from it); ``body_quat`` the orientation ``[w, x, y, z]``; ``body_linvel`` the COM velocity;
+``body_angmom`` the angular momentum ``L = R I Rᵀ ω`` about the COM, world frame. Angular momentum, not
+velocity, is the state (as in the course's state vector ``(x, A, p, L)``): with no torque it stays exactly
+constant. ``Body.angular_velocity`` computes ``ω = R I⁻¹ Rᵀ L``.
+
+The ``contact_*`` arrays are the impulses of the last step's contact points, kept to warm-start the next
+step; they are sorted by shape pair and change size every step.
 """
 
 from __future__ import annotations
 
 import hashlib
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
+from .geometry.manifold import MAX_POINTS
+
 __all__ = ["State"]
 
-_FIELDS = ("body_pos", "body_quat", "body_linvel", "body_angmom")
+_BODY_FIELDS = ("body_pos", "body_quat", "body_linvel", "body_angmom")
+_CONTACT_FIELDS = (
+    "contact_shape_a",
+    "contact_shape_b",
+    "contact_point_count",
+    "contact_feature",
+    "contact_normal_impulse",
+    "contact_tangent_impulse",
+)
+
+
+def _no_contacts() -> dict[str, np.ndarray]:
+    return {
+        "contact_shape_a": np.zeros(0, np.int64),
+        "contact_shape_b": np.zeros(0, np.int64),
+        "contact_point_count": np.zeros(0, np.int64),
+        "contact_feature": np.zeros((0, MAX_POINTS), np.int64),
+        "contact_normal_impulse": np.zeros((0, MAX_POINTS)),
+        "contact_tangent_impulse": np.zeros((0, MAX_POINTS, 3)),
+    }
 
 
 @dataclass(eq=False)
@@ -25,9 +51,14 @@ class State:
         body_pos: (body_count, 3) float64 [m], centre of mass, world frame.
         body_quat: (body_count, 4) float64, unit quaternion ``[w, x, y, z]``, body to world.
         body_linvel: (body_count, 3) float64 [m/s], COM velocity, world frame.
-        body_angmom: (body_count, 3) float64 [rad/s], world frame.
+        body_angmom: (body_count, 3) float64 [kg m²/s], about the COM, world frame.
         time: simulated time [s].
         step_count: number of steps taken.
+        contact_shape_a, contact_shape_b: (K,) int64 shape rows of the last step's manifolds.
+        contact_point_count: (K,) int64.
+        contact_feature: (K, 4) int64 feature ids of the points.
+        contact_normal_impulse: (K, 4) float64 [N s] of the last substep.
+        contact_tangent_impulse: (K, 4, 3) float64 [N s], friction impulses as world vectors.
     """
 
     body_pos: np.ndarray
@@ -36,6 +67,12 @@ class State:
     body_angmom: np.ndarray
     time: float = 0.0
     step_count: int = 0
+    contact_shape_a: np.ndarray = field(default_factory=lambda: _no_contacts()["contact_shape_a"])
+    contact_shape_b: np.ndarray = field(default_factory=lambda: _no_contacts()["contact_shape_b"])
+    contact_point_count: np.ndarray = field(default_factory=lambda: _no_contacts()["contact_point_count"])
+    contact_feature: np.ndarray = field(default_factory=lambda: _no_contacts()["contact_feature"])
+    contact_normal_impulse: np.ndarray = field(default_factory=lambda: _no_contacts()["contact_normal_impulse"])
+    contact_tangent_impulse: np.ndarray = field(default_factory=lambda: _no_contacts()["contact_tangent_impulse"])
 
     @classmethod
     def empty(cls, body_count: int = 0) -> State:
@@ -48,24 +85,38 @@ class State:
     def body_count(self) -> int:
         return int(self.body_pos.shape[0])
 
+    @property
+    def contact_count(self) -> int:
+        return int(self.contact_shape_a.shape[0])
+
     def copy(self) -> State:
-        return State(*(getattr(self, f).copy() for f in _FIELDS), time=self.time, step_count=self.step_count)
+        arrays = {f: getattr(self, f).copy() for f in _BODY_FIELDS + _CONTACT_FIELDS}
+        return State(**arrays, time=self.time, step_count=self.step_count)
 
     def assign(self, other: State) -> None:
-        """Overwrite this state with ``other`` in place (views held by users stay valid)."""
-        for f in _FIELDS:
+        """Overwrite this state with ``other``: body arrays in place (views held by users stay valid)."""
+        for f in _BODY_FIELDS:
             np.copyto(getattr(self, f), getattr(other, f))
+        for f in _CONTACT_FIELDS:
+            setattr(self, f, getattr(other, f).copy())
         self.time = other.time
         self.step_count = other.step_count
+
+    def forget_contacts(self) -> None:
+        """Drop the warm-start impulses (after the shapes changed)."""
+        for name, value in _no_contacts().items():
+            setattr(self, name, value)
 
     def digest(self) -> str:
         """sha256 over the arrays (fixed field order), the time and the step count."""
         h = hashlib.sha256()
-        for f in _FIELDS:
-            h.update(np.ascontiguousarray(getattr(self, f), dtype=np.float64).tobytes())
+        for f in _BODY_FIELDS + _CONTACT_FIELDS:
+            array = getattr(self, f)
+            h.update(str(array.shape).encode())
+            h.update(np.ascontiguousarray(array).tobytes())
         h.update(np.float64(self.time).tobytes())
         h.update(np.int64(self.step_count).tobytes())
         return h.hexdigest()
 
-    def arrays(self) -> dict[str, np.ndarray]:
-        return {f: getattr(self, f) for f in _FIELDS}
+    def body_arrays(self) -> dict[str, np.ndarray]:
+        return {f: getattr(self, f) for f in _BODY_FIELDS}

@@ -213,11 +213,11 @@ class World:
         if self._pending:
             new = [np.array(column) for column in zip(*self._pending, strict=True)]
             old = self._state
-            self._state = State(
-                *(np.concatenate([a, b]) for a, b in zip(old.arrays().values(), new, strict=True)),
-                time=old.time,
-                step_count=old.step_count,
-            )
+            grown = (np.concatenate([a, b]) for a, b in zip(old.body_arrays().values(), new, strict=True))
+            self._state = State(*grown, time=old.time, step_count=old.step_count)
+            # Shapes are only ever appended, so the warm-start impulses keep their shape rows.
+            for name in ("shape_a", "shape_b", "point_count", "feature", "normal_impulse", "tangent_impulse"):
+                setattr(self._state, f"contact_{name}", getattr(old, f"contact_{name}"))
             added = Inputs.zeros(len(self._pending))
             self._inputs = Inputs(
                 np.concatenate([self._inputs.body_force, added.body_force]),

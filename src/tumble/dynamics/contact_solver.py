@@ -1,0 +1,296 @@
+"""Contact solver: soft step (soft contact constraints, substeps, relax, restitution).
+
+The scheme of Box2D v3 / Box3D / Rapier (E. Catto, "Solver2D", 2024): each step finds contacts once, then
+runs ``substeps`` small steps of ``h = dt / substeps``. In every substep the velocities are integrated, the
+impulses of the last substep are re-applied (warm start), the contact constraints are solved once by
+sequential impulses with a *soft* position bias (a spring of ``contact_hertz`` and damping ratio, see
+``softness.py``), the positions are integrated, and a relax pass solves the constraints again without bias
+so that the push-out does not leave velocity behind. After the substeps, restitution is applied once from
+the relative normal velocities recorded before the step. Contacts with positive separation are speculative:
+they only stop the bodies from closing the gap faster than ``separation / h``, which keeps fast bodies
+from tunnelling through each other.
+
+Each contact point has a normal impulse ``λn ≥ 0`` and a friction impulse in the tangent plane bounded by the
+Coulomb cone ``|λt| ≤ μ λn`` (two tangent directions, clamped as a vector). Friction mixes as ``√(μa μb)``,
+restitution as ``max(ea, eb)``.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import NamedTuple
+
+import numpy as np
+
+from .._jit import inline, kernel
+from ..geometry.manifold import MAX_POINTS
+from ..math3d import (
+    add,
+    add_scaled,
+    cross,
+    dot,
+    load3,
+    load33,
+    mat_vec,
+    quat_conj,
+    quat_mul,
+    quat_rotate,
+    scale,
+    store3,
+    sub,
+)
+from .softness import soft_coefficients
+
+__all__ = ["ContactRows", "SolverSettings", "prepare_contacts", "solve_contacts", "warm_start_contacts"]
+
+
+class SolverSettings(NamedTuple):
+    """Contact solver settings (see ``World``): all SI."""
+
+    substeps: int
+    contact_hertz: float
+    contact_damping_ratio: float
+    contact_push_max: float  # [m/s] largest push-out velocity
+    restitution_threshold: float  # [m/s] slower impacts do not bounce
+    speculative_distance: float  # [m] contacts closer than this are created before touching
+
+
+class ContactRows(NamedTuple):
+    """Per-manifold solver data (capacity ``M``; the first ``count`` rows are used)."""
+
+    body_a: np.ndarray  # (M,) int64
+    body_b: np.ndarray  # (M,) int64
+    normal: np.ndarray  # (M, 3) from a to b, world
+    tangent1: np.ndarray  # (M, 3)
+    tangent2: np.ndarray  # (M, 3)
+    friction: np.ndarray  # (M,)
+    restitution: np.ndarray  # (M,)
+    point_count: np.ndarray  # (M,) int64
+    anchor_a: np.ndarray  # (M, 4, 3) contact point minus the COM of a at the start of the step
+    anchor_b: np.ndarray  # (M, 4, 3)
+    base_separation: np.ndarray  # (M, 4) separation minus n·(anchor_b − anchor_a)
+    normal_mass: np.ndarray  # (M, 4) 1 / (n·K n)
+    tangent_mass: np.ndarray  # (M, 4, 2)
+    normal_impulse: np.ndarray  # (M, 4) accumulated λn of the current substep [N s]
+    tangent_impulse: np.ndarray  # (M, 4, 2) accumulated friction impulse along tangent1, tangent2
+    max_normal_impulse: np.ndarray  # (M, 4) largest incremental λn of the step (did the point push?)
+    relative_velocity: np.ndarray  # (M, 4) normal relative velocity before the step [m/s]
+    softness: np.ndarray  # (M, 3) bias_rate, mass_scale, impulse_scale
+
+    @classmethod
+    def allocate(cls, capacity: int) -> ContactRows:
+        p = MAX_POINTS
+        return cls(
+            np.zeros(capacity, np.int64), np.zeros(capacity, np.int64), np.zeros((capacity, 3)),
+            np.zeros((capacity, 3)), np.zeros((capacity, 3)), np.zeros(capacity), np.zeros(capacity),
+            np.zeros(capacity, np.int64), np.zeros((capacity, p, 3)), np.zeros((capacity, p, 3)),
+            np.zeros((capacity, p)), np.zeros((capacity, p)), np.zeros((capacity, p, 2)), np.zeros((capacity, p)),
+            np.zeros((capacity, p, 2)), np.zeros((capacity, p)), np.zeros((capacity, p)), np.zeros((capacity, 3)),
+        )  # fmt: skip
+
+
+@inline
+def tangent_basis(n):
+    """Two unit tangents with ``(t1, t2, n)`` right-handed; continuous in ``n`` except across |n_x| = 0.577."""
+    if abs(n[0]) >= 0.57735:
+        t1 = (n[1], -n[0], 0.0)
+    else:
+        t1 = (0.0, n[2], -n[1])
+    inv = 1.0 / math.sqrt(dot(t1, t1))
+    t1 = scale(t1, inv)
+    return t1, cross(n, t1)
+
+
+@inline
+def _inverse_effective_mass(inv_mass_a, inv_i_a, r_a, inv_mass_b, inv_i_b, r_b, d):
+    """``1 / (m_a⁻¹ + m_b⁻¹ + (r_a×d)·I_a⁻¹(r_a×d) + (r_b×d)·I_b⁻¹(r_b×d))``, 0 if both are static."""
+    rd_a = cross(r_a, d)
+    rd_b = cross(r_b, d)
+    k = inv_mass_a + inv_mass_b + dot(rd_a, mat_vec(inv_i_a, rd_a)) + dot(rd_b, mat_vec(inv_i_b, rd_b))
+    return 1.0 / k if k > 0.0 else 0.0
+
+
+@inline
+def _relative_velocity(v_a, w_a, r_a, v_b, w_b, r_b):
+    """Velocity of b's contact point relative to a's: ``v_b + ω_b × r_b − v_a − ω_a × r_a``."""
+    return sub(add(v_b, cross(w_b, r_b)), add(v_a, cross(w_a, r_a)))
+
+
+@kernel
+def prepare_contacts(
+    manifolds, count, shape_body, shape_friction, shape_restitution, inv_mass, inv_inertia_world, pos, linvel,
+    angvel, warm_normal, warm_tangent, contact_hertz, damping_ratio, h, rows,
+):  # fmt: skip
+    """Anchors, effective masses, softness and warm-start impulses of every manifold.
+
+    Reads: manifolds (normal, points, separations), body state at the start of the step, warm impulses
+    ``warm_normal (M, 4)`` and world friction impulses ``warm_tangent (M, 4, 3)`` matched from the last step.
+    Writes: rows[:count].
+    """
+    for m in range(count):
+        a = shape_body[manifolds.shape_a[m]]
+        b = shape_body[manifolds.shape_b[m]]
+        rows.body_a[m], rows.body_b[m] = a, b
+        n = load3(manifolds.normal, m)
+        t1, t2 = tangent_basis(n)
+        store3(rows.normal, m, n)
+        store3(rows.tangent1, m, t1)
+        store3(rows.tangent2, m, t2)
+        rows.friction[m] = math.sqrt(shape_friction[manifolds.shape_a[m]] * shape_friction[manifolds.shape_b[m]])
+        rows.restitution[m] = max(shape_restitution[manifolds.shape_a[m]], shape_restitution[manifolds.shape_b[m]])
+        # A contact against a static body is stiffer (2x), as it has half the effective mass to move.
+        hertz = contact_hertz if inv_mass[a] > 0.0 and inv_mass[b] > 0.0 else 2.0 * contact_hertz
+        bias_rate, mass_scale, impulse_scale = soft_coefficients(hertz, damping_ratio, h)
+        rows.softness[m, 0], rows.softness[m, 1], rows.softness[m, 2] = bias_rate, mass_scale, impulse_scale
+        ma, mb = inv_mass[a], inv_mass[b]
+        ia, ib = load33(inv_inertia_world, a), load33(inv_inertia_world, b)
+        va, wa, vb, wb = load3(linvel, a), load3(angvel, a), load3(linvel, b), load3(angvel, b)
+        xa, xb = load3(pos, a), load3(pos, b)
+        rows.point_count[m] = manifolds.point_count[m]
+        for j in range(manifolds.point_count[m]):
+            p = load3(manifolds.point[m], j)
+            ra, rb = sub(p, xa), sub(p, xb)
+            store3(rows.anchor_a[m], j, ra)
+            store3(rows.anchor_b[m], j, rb)
+            rows.base_separation[m, j] = manifolds.separation[m, j] - dot(sub(rb, ra), n)
+            rows.normal_mass[m, j] = _inverse_effective_mass(ma, ia, ra, mb, ib, rb, n)
+            rows.tangent_mass[m, j, 0] = _inverse_effective_mass(ma, ia, ra, mb, ib, rb, t1)
+            rows.tangent_mass[m, j, 1] = _inverse_effective_mass(ma, ia, ra, mb, ib, rb, t2)
+            rows.normal_impulse[m, j] = warm_normal[m, j]
+            warm_t = load3(warm_tangent[m], j)
+            rows.tangent_impulse[m, j, 0] = dot(warm_t, t1)
+            rows.tangent_impulse[m, j, 1] = dot(warm_t, t2)
+            rows.max_normal_impulse[m, j] = 0.0
+            rows.relative_velocity[m, j] = dot(_relative_velocity(va, wa, ra, vb, wb, rb), n)
+
+
+@inline
+def _apply_impulse(rows, m, j, impulse, ma, ia, mb, ib, va, wa, vb, wb):
+    """Apply ``impulse`` (world) at point ``j``: ``−P`` to body a, ``+P`` to body b."""
+    ra, rb = load3(rows.anchor_a[m], j), load3(rows.anchor_b[m], j)
+    va = add_scaled(va, impulse, -ma)
+    wa = sub(wa, mat_vec(ia, cross(ra, impulse)))
+    vb = add_scaled(vb, impulse, mb)
+    wb = add(wb, mat_vec(ib, cross(rb, impulse)))
+    return va, wa, vb, wb
+
+
+@kernel
+def warm_start_contacts(rows, count, inv_mass, inv_inertia_world, linvel, angvel):
+    """Re-apply the accumulated impulses of every point (normal and friction).
+
+    Reads: rows.normal_impulse, rows.tangent_impulse. Writes: linvel, angvel.
+    """
+    for m in range(count):
+        a, b = rows.body_a[m], rows.body_b[m]
+        ma, mb = inv_mass[a], inv_mass[b]
+        ia, ib = load33(inv_inertia_world, a), load33(inv_inertia_world, b)
+        va, wa, vb, wb = load3(linvel, a), load3(angvel, a), load3(linvel, b), load3(angvel, b)
+        n, t1, t2 = load3(rows.normal, m), load3(rows.tangent1, m), load3(rows.tangent2, m)
+        for j in range(rows.point_count[m]):
+            impulse = add(
+                scale(n, rows.normal_impulse[m, j]),
+                add(scale(t1, rows.tangent_impulse[m, j, 0]), scale(t2, rows.tangent_impulse[m, j, 1])),
+            )
+            va, wa, vb, wb = _apply_impulse(rows, m, j, impulse, ma, ia, mb, ib, va, wa, vb, wb)
+        store3(linvel, a, va)
+        store3(angvel, a, wa)
+        store3(linvel, b, vb)
+        store3(angvel, b, wb)
+
+
+@inline
+def _current_separation(rows, m, j, n, dp_a, dq_a, dp_b, dq_b):
+    """Separation now: the anchors moved with their bodies since the start of the step."""
+    ra = quat_rotate(dq_a, load3(rows.anchor_a[m], j))
+    rb = quat_rotate(dq_b, load3(rows.anchor_b[m], j))
+    return dot(n, sub(add(dp_b, rb), add(dp_a, ra))) + rows.base_separation[m, j]
+
+
+@kernel
+def solve_contacts(
+    rows, count, inv_mass, inv_inertia_world, pos, quat, pos0, quat0, linvel, angvel, inv_h, push_max, use_bias
+):
+    """One Gauss–Seidel pass over all contacts: normal impulses (soft when ``use_bias``), then friction.
+
+    Reads: rows, body poses now (``pos``, ``quat``) and at the start of the step (``pos0``, ``quat0``).
+    Writes: rows.normal_impulse, rows.tangent_impulse, rows.max_normal_impulse, linvel, angvel.
+    """
+    for m in range(count):
+        a, b = rows.body_a[m], rows.body_b[m]
+        ma, mb = inv_mass[a], inv_mass[b]
+        ia, ib = load33(inv_inertia_world, a), load33(inv_inertia_world, b)
+        va, wa, vb, wb = load3(linvel, a), load3(angvel, a), load3(linvel, b), load3(angvel, b)
+        dp_a, dp_b = sub(load3(pos, a), load3(pos0, a)), sub(load3(pos, b), load3(pos0, b))
+        dq_a = quat_mul((quat[a, 0], quat[a, 1], quat[a, 2], quat[a, 3]), quat_conj(
+            (quat0[a, 0], quat0[a, 1], quat0[a, 2], quat0[a, 3])))  # fmt: skip
+        dq_b = quat_mul((quat[b, 0], quat[b, 1], quat[b, 2], quat[b, 3]), quat_conj(
+            (quat0[b, 0], quat0[b, 1], quat0[b, 2], quat0[b, 3])))  # fmt: skip
+        n, t1, t2 = load3(rows.normal, m), load3(rows.tangent1, m), load3(rows.tangent2, m)
+        bias_rate, mass_scale, impulse_scale = rows.softness[m, 0], rows.softness[m, 1], rows.softness[m, 2]
+        # Non-penetration: λn ≥ 0, soft towards zero separation; speculative while apart.
+        for j in range(rows.point_count[m]):
+            s = _current_separation(rows, m, j, n, dp_a, dq_a, dp_b, dq_b)
+            bias, m_scale, i_scale = 0.0, 1.0, 0.0
+            if s > 0.0:
+                bias = s * inv_h
+            elif use_bias:
+                bias, m_scale, i_scale = max(bias_rate * s, -push_max), mass_scale, impulse_scale
+            ra, rb = load3(rows.anchor_a[m], j), load3(rows.anchor_b[m], j)
+            vn = dot(_relative_velocity(va, wa, ra, vb, wb, rb), n)
+            old = rows.normal_impulse[m, j]
+            new = max(old - rows.normal_mass[m, j] * m_scale * (vn + bias) - i_scale * old, 0.0)
+            rows.normal_impulse[m, j] = new
+            rows.max_normal_impulse[m, j] = max(rows.max_normal_impulse[m, j], new - old)
+            va, wa, vb, wb = _apply_impulse(rows, m, j, scale(n, new - old), ma, ia, mb, ib, va, wa, vb, wb)
+        # Friction: both tangents at once, the accumulated impulse clamped to the Coulomb cone μ λn.
+        mu = rows.friction[m]
+        for j in range(rows.point_count[m]):
+            ra, rb = load3(rows.anchor_a[m], j), load3(rows.anchor_b[m], j)
+            dv = _relative_velocity(va, wa, ra, vb, wb, rb)
+            old1, old2 = rows.tangent_impulse[m, j, 0], rows.tangent_impulse[m, j, 1]
+            new1 = old1 - rows.tangent_mass[m, j, 0] * dot(dv, t1)
+            new2 = old2 - rows.tangent_mass[m, j, 1] * dot(dv, t2)
+            limit = mu * rows.normal_impulse[m, j]
+            length = math.sqrt(new1 * new1 + new2 * new2)
+            if length > limit:
+                ratio = limit / length
+                new1, new2 = new1 * ratio, new2 * ratio
+            rows.tangent_impulse[m, j, 0], rows.tangent_impulse[m, j, 1] = new1, new2
+            impulse = add(scale(t1, new1 - old1), scale(t2, new2 - old2))
+            va, wa, vb, wb = _apply_impulse(rows, m, j, impulse, ma, ia, mb, ib, va, wa, vb, wb)
+        store3(linvel, a, va)
+        store3(angvel, a, wa)
+        store3(linvel, b, vb)
+        store3(angvel, b, wb)
+
+
+@kernel
+def apply_restitution(rows, count, inv_mass, inv_inertia_world, linvel, angvel, threshold):
+    """Bounce: drive the normal velocity to ``−e`` times its value before the step, where it was an impact.
+
+    Only points that approached faster than ``threshold`` and pushed during the step bounce (Box2D v3).
+    Reads: rows.relative_velocity, rows.max_normal_impulse. Writes: rows.normal_impulse, linvel, angvel.
+    """
+    for m in range(count):
+        e = rows.restitution[m]
+        if e == 0.0:
+            continue
+        a, b = rows.body_a[m], rows.body_b[m]
+        ma, mb = inv_mass[a], inv_mass[b]
+        ia, ib = load33(inv_inertia_world, a), load33(inv_inertia_world, b)
+        va, wa, vb, wb = load3(linvel, a), load3(angvel, a), load3(linvel, b), load3(angvel, b)
+        n = load3(rows.normal, m)
+        for j in range(rows.point_count[m]):
+            if rows.relative_velocity[m, j] > -threshold or rows.max_normal_impulse[m, j] == 0.0:
+                continue
+            ra, rb = load3(rows.anchor_a[m], j), load3(rows.anchor_b[m], j)
+            vn = dot(_relative_velocity(va, wa, ra, vb, wb, rb), n)
+            old = rows.normal_impulse[m, j]
+            new = max(old - rows.normal_mass[m, j] * (vn + e * rows.relative_velocity[m, j]), 0.0)
+            rows.normal_impulse[m, j] = new
+            va, wa, vb, wb = _apply_impulse(rows, m, j, scale(n, new - old), ma, ia, mb, ib, va, wa, vb, wb)
+        store3(linvel, a, va)
+        store3(angvel, a, wa)
+        store3(linvel, b, vb)
+        store3(angvel, b, wb)
