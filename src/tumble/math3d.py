@@ -183,3 +183,69 @@ def quat_is_finite(q):
 def world_inertia_apply(q, inertia_local, v):
     """``R I Rᵀ v``: apply a body-frame inertia-like 9-tuple to a world vector."""
     return quat_rotate(q, mat_vec(inertia_local, quat_rotate_inv(q, v)))
+
+
+# --- rotation matrices and bounds --------------------------------------------------------------------
+
+
+@inline
+def quat_to_mat33(q):
+    """The rotation matrix of a unit quaternion as a row-major 9-tuple (``R v == quat_rotate(q, v)``)."""
+    w, x, y, z = q[0], q[1], q[2], q[3]
+    return (
+        1.0 - 2.0 * (y * y + z * z), 2.0 * (x * y - w * z), 2.0 * (x * z + w * y),
+        2.0 * (x * y + w * z), 1.0 - 2.0 * (x * x + z * z), 2.0 * (y * z - w * x),
+        2.0 * (x * z - w * y), 2.0 * (y * z + w * x), 1.0 - 2.0 * (x * x + y * y),
+    )  # fmt: skip
+
+
+@inline
+def abs_mat_vec(m, v):
+    """``|M| v`` with ``|M|`` the element-wise absolute value: the half-widths of a box of half-widths ``v``
+    turned by ``M`` (Ericson 2005, §4.2.6)."""
+    return (
+        abs(m[0]) * v[0] + abs(m[1]) * v[1] + abs(m[2]) * v[2],
+        abs(m[3]) * v[0] + abs(m[4]) * v[1] + abs(m[5]) * v[2],
+        abs(m[6]) * v[0] + abs(m[7]) * v[1] + abs(m[8]) * v[2],
+    )
+
+
+@inline
+def abs3(a):
+    return (abs(a[0]), abs(a[1]), abs(a[2]))
+
+
+# --- lengths, directions and columns (contact generation) --------------------------------------------
+
+
+@inline
+def length3(a):
+    return math.sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2])
+
+
+@inline
+def normalize3(a):
+    """``a / |a|``; ``a`` must be non-zero (callers pick their own fallback for the degenerate case)."""
+    inv = 1.0 / math.sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2])
+    return (a[0] * inv, a[1] * inv, a[2] * inv)
+
+
+@inline
+def lerp3(a, b, t):
+    """``a + t (b - a)``."""
+    return (a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1]), a[2] + t * (b[2] - a[2]))
+
+
+@inline
+def perpendicular3(a):
+    """A unit vector perpendicular to the unit vector ``a``: ``a`` crossed with an axis it is far from (some
+    component of a unit vector is at least 1/√3 ≈ 0.57735 in size, so the cross product is never short)."""
+    if abs(a[0]) >= 0.57735:
+        return normalize3((a[1], -a[0], 0.0))
+    return normalize3((0.0, a[2], -a[1]))
+
+
+@inline
+def mat_column(m, j):
+    """Column ``j`` of a row-major 9-tuple (for a rotation matrix: the image of axis ``j``)."""
+    return (m[j], m[3 + j], m[6 + j])

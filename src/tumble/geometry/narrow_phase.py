@@ -1,0 +1,201 @@
+"""Narrow phase: contact manifolds for the candidate pairs, and warm-start matching with the last step.
+
+``collide_pairs`` computes each shape's world pose, picks the ``collide_<a>_<b>`` kernel of the pair's types
+(lower type first, as the broad phase orders them) and writes the manifolds of the pairs that touch or are
+closer than their speculative margin. The margin of a pair grows with how far the two bodies can close in one
+step, so fast bodies get speculative contacts before they could pass through each other.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .._jit import kernel
+from ..math3d import add, load3, load4, quat_mul, quat_rotate
+from .collide_convex import collide_convex_convex, collide_convex_trimesh
+from .collide_primitives import (
+    collide_box_box,
+    collide_box_plane,
+    collide_capsule_box,
+    collide_capsule_capsule,
+    collide_capsule_plane,
+    collide_cylinder_plane,
+    collide_hull_plane,
+    collide_sphere_box,
+    collide_sphere_capsule,
+    collide_sphere_plane,
+    collide_sphere_sphere,
+)
+from .manifold import Manifolds
+
+__all__ = ["collide_pairs", "match_warm_start", "shape_world_pose"]
+
+SPHERE, CAPSULE, BOX, CYLINDER, HULL, PLANE, TRIMESH = 0, 1, 2, 3, 4, 5, 6
+
+
+@kernel
+def _collide_primitives(ta, tb, geom, sa, pa, qa, sb, pb, qb, margin, normal, point, separation, feature):
+    """Closed-form pairs of spheres, capsules, boxes and planes (``ta <= tb``)."""
+    if tb == PLANE:
+        if ta == SPHERE:
+            return collide_sphere_plane(geom, sa, pa, qa, sb, pb, qb, margin, normal, point, separation, feature)
+        if ta == CAPSULE:
+            return collide_capsule_plane(geom, sa, pa, qa, sb, pb, qb, margin, normal, point, separation, feature)
+        return collide_box_plane(geom, sa, pa, qa, sb, pb, qb, margin, normal, point, separation, feature)
+    if ta == SPHERE and tb == SPHERE:
+        return collide_sphere_sphere(geom, sa, pa, qa, sb, pb, qb, margin, normal, point, separation, feature)
+    if ta == SPHERE and tb == CAPSULE:
+        return collide_sphere_capsule(geom, sa, pa, qa, sb, pb, qb, margin, normal, point, separation, feature)
+    if ta == SPHERE:
+        return collide_sphere_box(geom, sa, pa, qa, sb, pb, qb, margin, normal, point, separation, feature)
+    if ta == CAPSULE and tb == CAPSULE:
+        return collide_capsule_capsule(geom, sa, pa, qa, sb, pb, qb, margin, normal, point, separation, feature)
+    if ta == CAPSULE:
+        return collide_capsule_box(geom, sa, pa, qa, sb, pb, qb, margin, normal, point, separation, feature)
+    return collide_box_box(geom, sa, pa, qa, sb, pb, qb, margin, normal, point, separation, feature)
+
+
+@kernel
+def _collide_convex(ta, tb, geom, sa, pa, qa, sb, pb, qb, margin, normal, point, separation, feature):
+    """Pairs with a cylinder or a hull: against a plane in closed form, else the general convex path."""
+    if tb == PLANE:
+        if ta == CYLINDER:
+            return collide_cylinder_plane(geom, sa, pa, qa, sb, pb, qb, margin, normal, point, separation, feature)
+        return collide_hull_plane(geom, sa, pa, qa, sb, pb, qb, margin, normal, point, separation, feature)
+    return collide_convex_convex(geom, sa, pa, qa, sb, pb, qb, margin, normal, point, separation, feature)
+
+
+@kernel
+def shape_world_pose(geom, s, body_pos, body_quat):
+    """World pose of shape ``s``: its body's COM frame composed with the shape's local pose."""
+    b = geom.shape_body[s]
+    qb = load4(body_quat, b)
+    pos = add(load3(body_pos, b), quat_rotate(qb, load3(geom.shape_pos_local, s)))
+    return pos, quat_mul(qb, load4(geom.shape_quat_local, s))
+
+
+@kernel
+def _reach(geom, s, body_linvel, body_angvel):
+    """How far any point of shape ``s`` can move per second: ``|v| + |ω| r`` with ``r`` its bounding radius."""
+    b = geom.shape_body[s]
+    c, hw = load3(geom.shape_aabb_center_local, s), load3(geom.shape_aabb_half_local, s)
+    radius = math.sqrt(c[0] ** 2 + c[1] ** 2 + c[2] ** 2) + math.sqrt(hw[0] ** 2 + hw[1] ** 2 + hw[2] ** 2)
+    v, w = load3(body_linvel, b), load3(body_angvel, b)
+    speed = math.sqrt(v[0] ** 2 + v[1] ** 2 + v[2] ** 2)
+    spin = math.sqrt(w[0] ** 2 + w[1] ** 2 + w[2] ** 2)
+    return speed + (spin * radius if math.isfinite(radius) else 0.0)
+
+
+@kernel
+def _pair_setup(geom, body_pos, body_quat, body_linvel, body_angvel, pairs_a, pairs_b, k, margin, dt, manifolds):
+    """Shapes and world poses of pair ``k`` (written to manifold row ``k``), and the pair's speculative margin:
+    the default plus how far the two can close during this step."""
+    sa, sb = pairs_a[k], pairs_b[k]
+    manifolds.shape_a[k], manifolds.shape_b[k] = sa, sb
+    pa, qa = shape_world_pose(geom, sa, body_pos, body_quat)
+    pb, qb = shape_world_pose(geom, sb, body_pos, body_quat)
+    reach = _reach(geom, sa, body_linvel, body_angvel) + _reach(geom, sb, body_linvel, body_angvel)
+    return sa, sb, pa, qa, pb, qb, margin + dt * reach
+
+
+# One kernel per family (same arguments): pair k's manifold goes to row k, its point count 0 if apart.
+
+
+@kernel
+def _collide_primitive_pairs(geom, pos, quat, linvel, angvel, pairs_a, pairs_b, listed, margin, dt, manifolds):
+    for k in listed:
+        sa, sb, pa, qa, pb, qb, mg = _pair_setup(geom, pos, quat, linvel, angvel, pairs_a, pairs_b, k, margin, dt,
+                                                 manifolds)  # fmt: skip
+        manifolds.point_count[k] = _collide_primitives(geom.shape_type[sa], geom.shape_type[sb], geom, sa, pa, qa,
+                                                       sb, pb, qb, mg, manifolds.normal[k], manifolds.point[k],
+                                                       manifolds.separation[k], manifolds.feature[k])  # fmt: skip
+
+
+@kernel
+def _collide_convex_pairs(geom, pos, quat, linvel, angvel, pairs_a, pairs_b, listed, margin, dt, manifolds):
+    for k in listed:
+        sa, sb, pa, qa, pb, qb, mg = _pair_setup(geom, pos, quat, linvel, angvel, pairs_a, pairs_b, k, margin, dt,
+                                                 manifolds)  # fmt: skip
+        manifolds.point_count[k] = _collide_convex(geom.shape_type[sa], geom.shape_type[sb], geom, sa, pa, qa, sb,
+                                                   pb, qb, mg, manifolds.normal[k], manifolds.point[k],
+                                                   manifolds.separation[k], manifolds.feature[k])  # fmt: skip
+
+
+@kernel
+def _collide_mesh_pairs(geom, pos, quat, linvel, angvel, pairs_a, pairs_b, listed, margin, dt, manifolds):
+    for k in listed:
+        sa, sb, pa, qa, pb, qb, mg = _pair_setup(geom, pos, quat, linvel, angvel, pairs_a, pairs_b, k, margin, dt,
+                                                 manifolds)  # fmt: skip
+        manifolds.point_count[k] = collide_convex_trimesh(geom, sa, pa, qa, sb, pb, qb, mg, manifolds.normal[k],
+                                                          manifolds.point[k], manifolds.separation[k],
+                                                          manifolds.feature[k])  # fmt: skip
+
+
+def collide_pairs(geom, body_pos, body_quat, body_linvel, body_angvel, pairs_a, pairs_b, margin, dt, manifolds):
+    """Manifolds of the candidate pairs that touch or are within their margin, in pair order; returns how many.
+
+    Pairs are split into three families (closed-form primitives, general convex, convex against a mesh) and
+    each family runs its own kernel, so that a scene compiles only the collision code it uses: the general
+    convex and mesh paths take most of the first-run compile time. Reads: geom, body poses and velocities
+    (ω world), pairs (lower shape type first). Writes: manifolds[:count].
+    """
+    n = pairs_a.shape[0]
+    if n == 0:
+        return 0
+    ta, tb = geom.shape_type[pairs_a], geom.shape_type[pairs_b]
+    mesh = tb == TRIMESH
+    convex = ~mesh & ((ta == CYLINDER) | (ta == HULL) | (tb == CYLINDER) | (tb == HULL))
+    primitive = ~mesh & ~convex
+    args = (geom, body_pos, body_quat, body_linvel, body_angvel, pairs_a, pairs_b)
+    for run, family in ((_collide_primitive_pairs, primitive), (_collide_convex_pairs, convex),
+                        (_collide_mesh_pairs, mesh)):  # fmt: skip
+        listed = np.flatnonzero(family)
+        if listed.size:
+            run(*args, listed, margin, dt, manifolds)
+    # Keep the pairs that made contact, in order, at the front.
+    touching = np.flatnonzero(manifolds.point_count[:n] > 0)
+    count = touching.size
+    if count < n:
+        for field in manifolds:
+            field[:count] = field[touching]
+    return count
+
+
+@kernel
+def match_warm_start(
+    manifolds, count, prev_a, prev_b, prev_point_count, prev_feature, prev_normal, prev_tangent, warm_normal,
+    warm_tangent,
+):  # fmt: skip
+    """Carry the last step's impulses to the points with the same shape pair and feature id.
+
+    Both lists are sorted by (shape_a, shape_b), so one merge walk finds every match.
+    Writes: warm_normal (count, 4), warm_tangent (count, 4, 3) (zeros for new points).
+    """
+    k = 0
+    for m in range(count):
+        a, b = manifolds.shape_a[m], manifolds.shape_b[m]
+        while k < prev_a.shape[0] and (prev_a[k] < a or (prev_a[k] == a and prev_b[k] < b)):
+            k += 1
+        found = k < prev_a.shape[0] and prev_a[k] == a and prev_b[k] == b
+        for j in range(manifolds.point_count[m]):
+            warm_normal[m, j] = 0.0
+            warm_tangent[m, j, 0] = warm_tangent[m, j, 1] = warm_tangent[m, j, 2] = 0.0
+            if not found:
+                continue
+            for jj in range(prev_point_count[k]):
+                if prev_feature[k, jj] == manifolds.feature[m, j]:
+                    warm_normal[m, j] = prev_normal[k, jj]
+                    warm_tangent[m, j, 0] = prev_tangent[k, jj, 0]
+                    warm_tangent[m, j, 1] = prev_tangent[k, jj, 1]
+                    warm_tangent[m, j, 2] = prev_tangent[k, jj, 2]
+                    break
+
+
+def allocate_manifolds(capacity: int) -> Manifolds:
+    return Manifolds.allocate(max(capacity, 1))
+
+
+def warm_arrays(capacity: int) -> tuple[np.ndarray, np.ndarray]:
+    return np.zeros((max(capacity, 1), 4)), np.zeros((max(capacity, 1), 4, 3))
