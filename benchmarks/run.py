@@ -311,7 +311,7 @@ def _many_bodies_world(n: int) -> tumble.World:
     world = tumble.World()  # default gravity (0, 0, -9.81)
     omega = peers.random_angular_velocities(n, SEED)
     for position, w in zip(peers.grid_positions(n), omega, strict=True):
-        world.add_body(tumble.Sphere(0.05), mass=1.0, position=position, angular_velocity=w)
+        world.add_body(tumble.Sphere(0.05), mass=1.0, position=position, angular_velocity=w, collision_mask=0)
     world.state  # noqa: B018
     return world
 
@@ -435,7 +435,8 @@ def first_step():
 def first_simulate():
     world = tumble.World()
     for i in range({bodies}):
-        world.add_body(tumble.Sphere(0.05), mass=1.0, position=(0.2 * i, 0.0, 10.0), angular_velocity=(1.0, 2.0, 3.0))
+        world.add_body(tumble.Sphere(0.05), mass=1.0, position=(0.2 * i, 0.0, 10.0),
+                       angular_velocity=(1.0, 2.0, 3.0), collision_mask=0)
     world.state
     t = time.perf_counter()
     world.simulate(1.0, 1e-3, record_every=1000)

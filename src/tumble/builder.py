@@ -95,8 +95,8 @@ class ModelBuilder:
             ),
             shape_friction=np.array([s.friction for _, s in specs], dtype=np.float64),
             shape_restitution=np.array([s.restitution for _, s in specs], dtype=np.float64),
-            shape_group=np.array([s.group for _, s in specs], dtype=np.int64),
-            shape_mask=np.array([s.mask for _, s in specs], dtype=np.int64),
+            shape_group=np.array([s.group for _, s in specs], dtype=np.uint32),
+            shape_mask=np.array([s.mask for _, s in specs], dtype=np.uint32),
             has_contacts=_contacts_possible(specs, is_dynamic),
             shapes=tuple(s.shape for _, s in specs),
         )

@@ -48,8 +48,19 @@ class Body:
         return self._model().body_com_local[self._index]
 
     def _require_dynamic(self, what: str) -> None:
+        """Refuse to move a static body; wake a sleeping one (with its island), since it is about to move."""
         if self.is_static:
             raise ValueError(f"{what}: body {self.name or self._index!r} is static and cannot move")
+        s = self._state()
+        if s.body_sleeping[self._index]:
+            island = s.body_island == s.body_island[self._index]
+            s.body_sleeping[island] = False
+            s.body_sleep_time[island] = 0.0
+
+    @property
+    def sleeping(self) -> bool:
+        """Whether the body sleeps (is at rest and not simulated until touched or pushed)."""
+        return bool(self._state().body_sleeping[self._index])
 
     # --- pose and velocity --------------------------------------------------------------------------
 

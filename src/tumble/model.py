@@ -47,7 +47,7 @@ class Model:
             ``model.shape_body``, ``shape_type``, ``shape_params``, ``shape_pos_local`` and ``shape_quat_local``
             read from it.
         shape_friction, shape_restitution: (shape_count,) float64.
-        shape_group, shape_mask: (shape_count,) int64 collision filter bits (32 used).
+        shape_group, shape_mask: (shape_count,) uint32 collision filter bits.
         has_contacts: whether two shapes of different bodies can touch (then the contact solver steps).
         shapes: the shape objects, in row order (for geometry that does not fit the arrays).
     """

@@ -1,24 +1,44 @@
 """One step of a world: the order of the stages, and nothing else (no arithmetic here).
 
-Free bodies (no contacts, no joints yet):
+Free bodies (nothing can touch):
 
-    advance_free_bodies   model.body_*, inputs  -> state.body_pos/quat/linvel/angmom   (dynamics/integrate.py)
-    clear inputs          applied forces act during one step only                     (inputs.py)
+    advance_free_bodies   model.body_*, inputs  -> state.body_*            (dynamics/integrate.py)
 
-The contact and joint stages of DESIGN.md (broad phase, narrow phase, soft-step substeps) slot in
-before the integration when the model has constraints.
+Bodies with contacts (the soft step of DESIGN.md):
+
+    to_angular_velocity   state.body_angmom      -> scratch.body_angvel, body_inv_inertia_world (dynamics/substep.py)
+    update_aabbs          state, geometry        -> world bounds           (geometry/broad_phase.py)
+    find_pairs            bounds, filters        -> candidate pairs        (geometry/broad_phase.py)
+    collide_pairs         pairs                  -> scratch.manifolds      (geometry/narrow_phase.py)
+    match_warm_start      state.contact_*        -> scratch.warm_*         (geometry/narrow_phase.py)
+    wake_touched          manifolds              -> state.body_sleeping    (dynamics/islands.py)
+    prepare_contacts      manifolds, bodies      -> scratch.rows           (dynamics/contact_solver.py)
+    run_substeps          integrate v, warm start, solve, integrate x, relax   (dynamics/substep.py)
+    apply_restitution     rows                   -> velocities             (dynamics/contact_solver.py)
+    store impulses        rows                   -> state.contact_*        (here)
+    update_sleep          manifolds, velocities  -> state.body_sleep_*     (dynamics/islands.py)
+    to_angular_momentum   scratch.body_angvel    -> state.body_angmom      (dynamics/substep.py)
+
+Then, either way: advance time and the step count, and clear the applied loads.
 """
 
 from __future__ import annotations
 
+import numpy as np
+
+from .dynamics.contact_solver import apply_restitution, prepare_contacts
 from .dynamics.integrate import Recording, advance_free_bodies
+from .dynamics.islands import update_sleep, wake_touched
+from .dynamics.substep import run_substeps, to_angular_momentum, to_angular_velocity
+from .geometry.broad_phase import find_pairs, update_aabbs
+from .geometry.narrow_phase import collide_pairs, match_warm_start
 from .inputs import Inputs
 from .model import Model
-from .params import Params
+from .params import Integrator, Params
 from .scratch import Scratch
 from .state import State
 
-__all__ = ["simulate_steps"]
+__all__ = ["simulate_steps", "contact_step"]
 
 
 def simulate_steps(
@@ -33,25 +53,210 @@ def simulate_steps(
     record_every: int = 0,
 ) -> tuple[int, int]:
     """Advance ``n_steps`` steps of ``h``; returns ``(steps_done, failing_body)`` (-1 when all went well)."""
-    method = params.resolve_integrator(model.has_constraints)
-    steps_done, failing_body = advance_free_bodies(
-        model,
-        state,
-        inputs.body_force,
-        inputs.body_torque,
-        scratch,
-        h,
-        n_steps,
-        method,
-        recording,
-        record_every,
-    )
-    state.step_count += steps_done
-    # Accumulate time step by step so that simulate(n steps) and n calls of step() agree bit for bit.
-    time = state.time
-    for _ in range(steps_done):
-        time += h
-    state.time = time
+    if model.has_constraints:
+        steps_done, failing_body = _contact_steps(
+            model, state, inputs, params, scratch, h, n_steps, recording, record_every
+        )
+    else:
+        method = params.resolve_integrator(False)
+        steps_done, failing_body = advance_free_bodies(
+            model, state, inputs.body_force, inputs.body_torque, scratch, h, n_steps, method, recording, record_every
+        )
+        _advance_clock(state, h, steps_done)
     if steps_done > 0:
         inputs.clear()
     return steps_done, failing_body
+
+
+def _advance_clock(state: State, h: float, steps: int) -> None:
+    # Accumulate time step by step so that simulate(n steps) and n calls of step() agree bit for bit.
+    time = state.time
+    for _ in range(steps):
+        time += h
+    state.time = time
+    state.step_count += steps
+
+
+def _contact_steps(model, state, inputs, params, scratch, h, n_steps, recording, record_every) -> tuple[int, int]:
+    """Soft steps one after the other; on a non-finite value, restore the state before that step."""
+    if params.resolve_integrator(True) != Integrator.SYMPLECTIC:
+        raise ValueError(
+            f"integrator={params.integrator!r} integrates free bodies only; a world whose shapes can touch steps "
+            "with the contact solver: use integrator='auto' or 'symplectic'"
+        )
+    zero = Inputs.zeros(model.body_count)
+    for step in range(n_steps):
+        before = state.copy()
+        loads = inputs if step == 0 else zero  # applied loads act during the first step only
+        contact_step(model, state, loads, params, scratch, h)
+        bad = _first_non_finite_body(state)
+        if bad >= 0:
+            state.assign(before)
+            return step, bad
+        _advance_clock(state, h, 1)
+        if record_every > 0 and (step + 1) % record_every == 0:
+            frame = (step + 1) // record_every - 1
+            np.copyto(recording.pos[frame], state.body_pos)
+            np.copyto(recording.quat[frame], state.body_quat)
+            np.copyto(recording.linvel[frame], state.body_linvel)
+            np.copyto(recording.angmom[frame], state.body_angmom)
+    return n_steps, -1
+
+
+def _first_non_finite_body(state: State) -> int:
+    finite = np.isfinite(state.body_pos).all(axis=1) & np.isfinite(state.body_quat).all(axis=1)
+    finite &= np.isfinite(state.body_linvel).all(axis=1) & np.isfinite(state.body_angmom).all(axis=1)
+    bad = np.flatnonzero(~finite)
+    return int(bad[0]) if bad.size else -1
+
+
+def contact_step(model: Model, state: State, inputs: Inputs, params: Params, scratch: Scratch, dt: float) -> None:
+    """One soft step of ``dt`` (see the module docstring for the stages)."""
+    settings = params.solver
+    h = dt / settings.substeps
+    bodies, geom = model.body_arrays, model.geometry
+    angvel, inv_inertia_world = scratch.body_angvel, scratch.body_inv_inertia_world
+    # Angular velocities and world inverse inertias at the start of the step.
+    to_angular_velocity(bodies, state.body_quat, state.body_angmom, angvel, inv_inertia_world)
+    # Broad phase: bounds swept over the step, candidate pairs.
+    update_aabbs(
+        geom,
+        state.body_pos,
+        state.body_quat,
+        state.body_linvel,
+        settings.speculative_distance,
+        dt,
+        scratch.aabb_lo,
+        scratch.aabb_hi,
+    )
+    pairs_a, pairs_b = find_pairs(
+        geom,
+        state.body_pos,
+        state.body_quat,
+        scratch.aabb_lo,
+        scratch.aabb_hi,
+        model.body_is_dynamic,
+        shape_group=model.shape_group,
+        shape_mask=model.shape_mask,
+        margin=settings.speculative_distance,
+        buffer=scratch.pairs,
+    )
+    # Narrow phase: manifolds, and the impulses of the same points last step.
+    scratch.reserve_contacts(pairs_a.shape[0])
+    manifolds = scratch.manifolds
+    count = collide_pairs(
+        geom,
+        state.body_pos,
+        state.body_quat,
+        state.body_linvel,
+        angvel,
+        pairs_a,
+        pairs_b,
+        settings.speculative_distance,
+        dt,
+        manifolds,
+    )
+    match_warm_start(
+        manifolds,
+        count,
+        state.contact_shape_a,
+        state.contact_shape_b,
+        state.contact_point_count,
+        state.contact_feature,
+        state.contact_normal_impulse,
+        state.contact_tangent_impulse,
+        scratch.warm_normal,
+        scratch.warm_tangent,
+    )
+    # Sleeping islands that an awake body touches wake up; bodies that do not move count as fixed.
+    if settings.sleep and state.body_sleeping.any():
+        wake_touched(
+            model.body_is_dynamic,
+            geom.shape_body,
+            manifolds,
+            count,
+            state.body_sleep_time,
+            state.body_sleeping,
+            state.body_island,
+        )
+    moving = model.body_is_dynamic & ~state.body_sleeping
+    inv_mass = np.where(moving, bodies.inv_mass, 0.0)
+    inv_inertia_world[~moving] = 0.0
+    # Solver: prepare once, then the substeps, then restitution.
+    rows = scratch.rows
+    prepare_contacts(
+        manifolds,
+        count,
+        geom.shape_body,
+        model.shape_friction,
+        model.shape_restitution,
+        inv_mass,
+        inv_inertia_world,
+        state.body_pos,
+        state.body_linvel,
+        angvel,
+        scratch.warm_normal,
+        scratch.warm_tangent,
+        settings.contact_hertz,
+        settings.contact_damping_ratio,
+        h,
+        rows,
+    )
+    pos0, quat0 = state.body_pos.copy(), state.body_quat.copy()
+    run_substeps(
+        bodies,
+        moving,
+        inv_mass,
+        model.gravity,
+        inputs.body_force,
+        inputs.body_torque,
+        rows,
+        count,
+        inv_inertia_world,
+        state.body_pos,
+        state.body_quat,
+        pos0,
+        quat0,
+        state.body_linvel,
+        angvel,
+        h,
+        settings.substeps,
+        settings.contact_push_max,
+    )
+    apply_restitution(rows, count, inv_mass, inv_inertia_world, state.body_pos, state.body_quat, pos0, quat0,
+                      state.body_linvel, angvel, settings.restitution_threshold)  # fmt: skip
+    _store_impulses(state, manifolds, rows, count)
+    scratch.contact_count = count
+    # Islands whose bodies have all been still long enough go to sleep.
+    if settings.sleep:
+        update_sleep(
+            model.body_is_dynamic,
+            geom.shape_body,
+            manifolds,
+            count,
+            state.body_linvel,
+            angvel,
+            dt,
+            settings.sleep_linear,
+            settings.sleep_angular,
+            settings.time_to_sleep,
+            state.body_sleep_time,
+            state.body_sleeping,
+            state.body_island,
+            scratch.island_parent,
+            scratch.island_min_time,
+        )
+    to_angular_momentum(bodies, state.body_quat, angvel, state.body_angmom)
+
+
+def _store_impulses(state: State, manifolds, rows, count: int) -> None:
+    """Keep this step's impulses, keyed by shape pair and feature, to warm-start the next step."""
+    state.contact_shape_a = manifolds.shape_a[:count].copy()
+    state.contact_shape_b = manifolds.shape_b[:count].copy()
+    state.contact_point_count = manifolds.point_count[:count].copy()
+    state.contact_feature = manifolds.feature[:count].copy()
+    state.contact_normal_impulse = rows.normal_impulse[:count].copy()
+    state.contact_tangent_impulse = (
+        rows.tangent_impulse[:count, :, 0, None] * rows.tangent1[:count, None, :]
+        + rows.tangent_impulse[:count, :, 1, None] * rows.tangent2[:count, None, :]
+    )

@@ -8,6 +8,7 @@ import numpy as np
 
 from .dynamics.contact_solver import ContactRows
 from .dynamics.integrate import Recording, empty_recording
+from .geometry.broad_phase import PairBuffer
 from .geometry.manifold import MAX_POINTS, Manifolds
 
 __all__ = ["Scratch"]
@@ -26,6 +27,8 @@ class Scratch:
         body_inv_inertia_world: (body_count, 3, 3) ``R I⁻¹ Rᵀ`` at the start of the contact step.
         manifolds, rows, warm_normal, warm_tangent: contact buffers, grown as needed.
         contact_count: manifolds in use after the last contact step (``World.contacts`` reads them).
+        aabb_lo, aabb_hi: (shape_count, 3) world bounds of the shapes; pairs: the broad phase's output buffer.
+        island_parent, island_min_time: (body_count,) union-find work arrays of the sleep pass.
     """
 
     backup_pos: np.ndarray
@@ -41,14 +44,23 @@ class Scratch:
     warm_normal: np.ndarray = field(default_factory=lambda: np.zeros((1, MAX_POINTS)))
     warm_tangent: np.ndarray = field(default_factory=lambda: np.zeros((1, MAX_POINTS, 3)))
     contact_count: int = 0
+    aabb_lo: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
+    aabb_hi: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
+    pairs: PairBuffer = field(default_factory=PairBuffer)
+    island_parent: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
+    island_min_time: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
     @classmethod
-    def for_bodies(cls, body_count: int) -> Scratch:
-        return cls(
+    def for_world(cls, body_count: int, shape_count: int) -> Scratch:
+        scratch = cls(
             np.zeros((body_count, 3)), np.zeros((body_count, 4)), np.zeros((body_count, 3)),
             np.zeros((body_count, 3)), np.full(body_count, -1, dtype=np.int64), empty_recording(body_count),
             np.zeros((body_count, 3)), np.zeros((body_count, 3, 3)),
         )  # fmt: skip
+        scratch.aabb_lo, scratch.aabb_hi = np.zeros((shape_count, 3)), np.zeros((shape_count, 3))
+        scratch.island_parent = np.zeros(body_count, np.int64)
+        scratch.island_min_time = np.zeros(body_count)
+        return scratch
 
     @property
     def backup(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:

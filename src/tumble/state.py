@@ -21,7 +21,15 @@ from .geometry.manifold import MAX_POINTS
 
 __all__ = ["State"]
 
-_BODY_FIELDS = ("body_pos", "body_quat", "body_linvel", "body_angmom")
+_BODY_FIELDS = (
+    "body_pos",
+    "body_quat",
+    "body_linvel",
+    "body_angmom",
+    "body_sleep_time",
+    "body_sleeping",
+    "body_island",
+)
 _CONTACT_FIELDS = (
     "contact_shape_a",
     "contact_shape_b",
@@ -52,6 +60,9 @@ class State:
         body_quat: (body_count, 4) float64, unit quaternion ``[w, x, y, z]``, body to world.
         body_linvel: (body_count, 3) float64 [m/s], COM velocity, world frame.
         body_angmom: (body_count, 3) float64 [kg m²/s], about the COM, world frame.
+        body_sleep_time: (body_count,) float64 [s] the body has been slower than the sleep thresholds.
+        body_sleeping: (body_count,) bool; a sleeping body is not moved until it is woken.
+        body_island: (body_count,) int64, the root body of the island it last slept in (-1: none).
         time: simulated time [s].
         step_count: number of steps taken.
         contact_shape_a, contact_shape_b: (K,) int64 shape rows of the last step's manifolds.
@@ -65,6 +76,9 @@ class State:
     body_quat: np.ndarray
     body_linvel: np.ndarray
     body_angmom: np.ndarray
+    body_sleep_time: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    body_sleeping: np.ndarray = field(default_factory=lambda: np.zeros(0, bool))
+    body_island: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
     time: float = 0.0
     step_count: int = 0
     contact_shape_a: np.ndarray = field(default_factory=lambda: _no_contacts()["contact_shape_a"])
@@ -79,7 +93,18 @@ class State:
         quat = np.zeros((body_count, 4))
         quat[:, 0] = 1.0
         zeros3 = np.zeros((body_count, 3))
-        return cls(zeros3.copy(), quat, zeros3.copy(), zeros3.copy())
+        return cls(
+            zeros3.copy(), quat, zeros3.copy(), zeros3.copy(), np.zeros(body_count), np.zeros(body_count, bool),
+            np.full(body_count, -1, np.int64),
+        )  # fmt: skip
+
+    def grown(self, pos, quat, linvel, angmom) -> State:
+        """A new state with rows appended for new bodies (awake, at the given poses and momenta)."""
+        new = State.empty(len(pos))
+        new.body_pos[:], new.body_quat[:], new.body_linvel[:], new.body_angmom[:] = pos, quat, linvel, angmom
+        arrays = {f: np.concatenate([getattr(self, f), getattr(new, f)]) for f in _BODY_FIELDS}
+        contacts = {f: getattr(self, f) for f in _CONTACT_FIELDS}  # shapes are only appended: rows stay valid
+        return State(**arrays, **contacts, time=self.time, step_count=self.step_count)
 
     @property
     def body_count(self) -> int:

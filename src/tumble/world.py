@@ -7,6 +7,7 @@ batch work (re-read it after adding bodies: adding reallocates them).
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 
 import numpy as np
@@ -19,8 +20,9 @@ from .handles import Body
 from .inputs import Inputs
 from .mass import MassProperties
 from .model import Model
-from .params import INTEGRATOR_NAMES, Params
+from .params import DEFAULT_SOLVER, INTEGRATOR_NAMES, Params, SolverSettings
 from .pipeline import simulate_steps
+from .queries import Contacts, RayHit
 from .rotation import quat_rotate
 from .scratch import Scratch
 from .shapes import Plane, Shape, TriMesh
@@ -39,12 +41,18 @@ def _check_integrator(integrator) -> str:
     return integrator
 
 
-def _shape_items(shape, friction: float, restitution: float) -> list[ShapeSpec]:
+def _check_filter(name: str, bits) -> int:
+    if isinstance(bits, bool) or not isinstance(bits, (int, np.integer)) or not 0 <= int(bits) <= 0xFFFFFFFF:
+        raise ValueError(f"{name} must be an integer of 32 bits (0 to 0xFFFFFFFF), got {bits!r}")
+    return int(bits)
+
+
+def _shape_items(shape, friction: float, restitution: float, group: int = 1, mask: int = 0xFFFFFFFF) -> list[ShapeSpec]:
     """``None``, one shape, or a list of ``(shape, position[, orientation])`` in the body frame."""
     if shape is None:
         return []
     if isinstance(shape, Shape):
-        return [ShapeSpec(shape, np.zeros(3), _IDENTITY.copy(), friction, restitution)]
+        return [ShapeSpec(shape, np.zeros(3), _IDENTITY.copy(), friction, restitution, group, mask)]
     if not isinstance(shape, Sequence) or isinstance(shape, str) or len(shape) == 0:
         raise TypeError(
             f"shape must be a Shape, a non-empty list of (shape, position[, orientation]) or None, got {shape!r}"
@@ -55,7 +63,7 @@ def _shape_items(shape, friction: float, restitution: float) -> list[ShapeSpec]:
             raise TypeError(f"shape[{k}] must be (shape, position[, orientation]), got {item!r}")
         position = as_vector3(f"shape[{k}] position", item[1])
         quat = as_quaternion(f"shape[{k}] orientation", item[2]) if len(item) == 3 else _IDENTITY.copy()
-        items.append(ShapeSpec(item[0], position, quat, friction, restitution))
+        items.append(ShapeSpec(item[0], position, quat, friction, restitution, group, mask))
     return items
 
 
@@ -108,14 +116,35 @@ class World:
             ``docs/integrators.md`` says which to use when.
     """
 
-    def __init__(self, gravity=(0.0, 0.0, -9.81), *, integrator: str = "auto"):
+    def __init__(
+        self,
+        gravity=(0.0, 0.0, -9.81),
+        *,
+        integrator: str = "auto",
+        substeps: int = DEFAULT_SOLVER.substeps,
+        contact_hertz: float = DEFAULT_SOLVER.contact_hertz,
+        contact_damping_ratio: float = DEFAULT_SOLVER.contact_damping_ratio,
+        contact_push_max: float = DEFAULT_SOLVER.contact_push_max,
+        restitution_threshold: float = DEFAULT_SOLVER.restitution_threshold,
+        speculative_distance: float = DEFAULT_SOLVER.speculative_distance,
+        sleep: bool = DEFAULT_SOLVER.sleep,
+    ):
         self._gravity = as_vector3("gravity", gravity)
         self._params = Params(integrator=_check_integrator(integrator))
+        self.set_solver(
+            substeps=substeps,
+            contact_hertz=contact_hertz,
+            contact_damping_ratio=contact_damping_ratio,
+            contact_push_max=contact_push_max,
+            restitution_threshold=restitution_threshold,
+            speculative_distance=speculative_distance,
+            sleep=sleep,
+        )
         self._builder = ModelBuilder()
         self._model: Model | None = None
         self._state = State.empty(0)
         self._inputs = Inputs.zeros(0)
-        self._scratch = Scratch.for_bodies(0)
+        self._scratch = Scratch.for_world(0, 0)
         self._pending: list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = []
         self._bodies: list[Body] = []
 
@@ -136,9 +165,17 @@ class World:
         restitution: float = 0.0,
         linear_damping: float = 0.0,
         angular_damping: float = 0.0,
+        collision_group: int = 1,
+        collision_mask: int = 0xFFFFFFFF,
         name: str | None = None,
     ) -> Body:
-        """Add a dynamic body; see ``docs/api.md``. ``velocity`` is that of the centre of mass."""
+        """Add a dynamic body. ``velocity`` is that of the centre of mass.
+
+        ``shape`` is a :class:`~tumble.Shape`, a list of ``(shape, position[, orientation])`` in the body frame
+        (a compound body), or ``None`` with ``mass=`` and ``inertia=``. Two shapes collide when
+        ``collision_group & other.collision_mask`` and ``other.collision_group & collision_mask`` are both
+        non-zero; ``collision_mask=0`` turns collisions off for this body.
+        """
         position = as_vector3("position", position)
         quat = as_quaternion("orientation", orientation)
         velocity = as_vector3("velocity", velocity)
@@ -147,7 +184,8 @@ class World:
         linear_damping = as_float("linear_damping", linear_damping, nonnegative=True)
         angular_damping = as_float("angular_damping", angular_damping, nonnegative=True)
         name = self._check_name(name)
-        items = _shape_items(shape, friction, restitution)
+        group, mask = _check_filter("collision_group", collision_group), _check_filter("collision_mask", collision_mask)
+        items = _shape_items(shape, friction, restitution, group, mask)
         mp = _body_mass_properties(items, mass, density, inertia)
         _require_definite(mp)
         com = position + quat_rotate(quat, mp.com)
@@ -165,6 +203,8 @@ class World:
         orientation=(1.0, 0.0, 0.0, 0.0),
         friction: float = 0.5,
         restitution: float = 0.0,
+        collision_group: int = 1,
+        collision_mask: int = 0xFFFFFFFF,
         name: str | None = None,
     ) -> Body:
         """Add fixed geometry (a plane, a mesh, any shape, or a compound list); it never moves."""
@@ -174,7 +214,8 @@ class World:
         quat = as_quaternion("orientation", orientation)
         friction, restitution = self._check_material(friction, restitution)
         name = self._check_name(name)
-        items = _shape_items(shape, friction, restitution)
+        group, mask = _check_filter("collision_group", collision_group), _check_filter("collision_mask", collision_mask)
+        items = _shape_items(shape, friction, restitution, group, mask)
         index = self._builder.add_body(None, items, name=name)
         return self._append(index, position, quat, np.zeros(3), np.zeros(3))
 
@@ -210,21 +251,15 @@ class World:
         if self._model is not None:
             return
         self._model = self._builder.finalize(self._gravity)
+        self._scratch = Scratch.for_world(self._model.body_count, self._model.shape_count)
         if self._pending:
-            new = [np.array(column) for column in zip(*self._pending, strict=True)]
-            old = self._state
-            grown = (np.concatenate([a, b]) for a, b in zip(old.body_arrays().values(), new, strict=True))
-            self._state = State(*grown, time=old.time, step_count=old.step_count)
-            # Shapes are only ever appended, so the warm-start impulses keep their shape rows.
-            for name in ("shape_a", "shape_b", "point_count", "feature", "normal_impulse", "tangent_impulse"):
-                setattr(self._state, f"contact_{name}", getattr(old, f"contact_{name}"))
+            self._state = self._state.grown(*(np.array(column) for column in zip(*self._pending, strict=True)))
             added = Inputs.zeros(len(self._pending))
             self._inputs = Inputs(
                 np.concatenate([self._inputs.body_force, added.body_force]),
                 np.concatenate([self._inputs.body_torque, added.body_torque]),
             )
             self._pending.clear()
-            self._scratch = Scratch.for_bodies(self._state.body_count)
 
     # --- arrays -------------------------------------------------------------------------------------
 
@@ -266,6 +301,33 @@ class World:
     def gravity(self, value) -> None:
         self._gravity = as_vector3("gravity", value)
         self._model = None
+
+    @property
+    def solver(self) -> SolverSettings:
+        """The contact solver's settings (read-only; change them with :meth:`set_solver`)."""
+        return self._params.solver
+
+    def set_solver(self, **settings) -> None:
+        """Change contact solver settings by name: ``substeps`` (int >= 1), ``contact_hertz`` (> 0),
+        ``contact_damping_ratio`` (>= 0), ``contact_push_max`` [m/s] (> 0), ``restitution_threshold`` [m/s] (>= 0),
+        ``speculative_distance`` [m] (>= 0), ``sleep`` (bool), ``sleep_linear`` [m/s], ``sleep_angular`` [rad/s],
+        ``time_to_sleep`` [s] (all >= 0)."""
+        current = self._params.solver._asdict()
+        for key, value in settings.items():
+            if key not in current:
+                raise TypeError(f"unknown solver setting {key!r}; settings: {sorted(current)}")
+            if key == "substeps":
+                if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
+                    raise ValueError(f"substeps must be an integer >= 1, got {value!r}")
+                current[key] = int(value)
+            elif key == "sleep":
+                if not isinstance(value, (bool, np.bool_)):
+                    raise TypeError(f"sleep must be True or False, got {value!r}")
+                current[key] = bool(value)
+            else:
+                positive = key in ("contact_hertz", "contact_push_max")
+                current[key] = as_float(key, value, positive=positive, nonnegative=not positive)
+        self._params.solver = SolverSettings(**current)
 
     @property
     def integrator(self) -> str:
@@ -374,6 +436,41 @@ class World:
         point = as_vector3("point", point)
         s = self.state
         return diagnostics.angular_momentum(self._model.body_mass, s.body_pos, s.body_linvel, s.body_angmom, point)
+
+    # --- queries ------------------------------------------------------------------------------------
+
+    def contacts(self) -> Contacts:
+        """The contact points of the last step, with the impulses the solver applied (see :class:`Contacts`)."""
+        model = self.model
+        s = self._scratch
+        count = s.contact_count if model.has_contacts else 0
+        return Contacts.from_solver(model.shape_body, s.manifolds, s.rows, count)
+
+    def query_ray(self, origin, direction, max_distance: float = math.inf, *, mask: int = 0xFFFFFFFF) -> RayHit | None:
+        """The first shape hit by the ray from ``origin`` along ``direction`` within ``max_distance``, or None.
+
+        ``direction`` need not be unit; only shapes whose ``collision_group`` shares a bit with ``mask`` count.
+        A ray that starts inside a solid shape hits it at distance 0.
+        """
+        from .geometry.raycast import raycast_shapes
+
+        origin = as_vector3("origin", origin)
+        direction = as_vector3("direction", direction)
+        length = float(np.linalg.norm(direction))
+        if length == 0.0:
+            raise ValueError(f"direction must be non-zero, got {direction.tolist()}")
+        if not (isinstance(max_distance, float) and max_distance == math.inf):
+            max_distance = as_float("max_distance", max_distance, nonnegative=True)
+        mask = _check_filter("mask", mask)
+        model, state = self.model, self._state
+        shape, distance, point, normal = raycast_shapes(
+            model.geometry, state.body_pos, state.body_quat, origin, direction / length, max_distance,
+            model.shape_group, np.uint32(mask),
+        )  # fmt: skip
+        if shape < 0:
+            return None
+        body = self._bodies[int(model.shape_body[shape])]
+        return RayHit(body, int(shape), float(distance), np.array(point), np.array(normal))
 
     def __repr__(self) -> str:
         dynamic = sum(1 for b in self._bodies if not b.is_static)

@@ -41,6 +41,10 @@ from ..math3d import (
 )
 from .softness import soft_coefficients
 
+# Gauss-Seidel sweeps over the normal points of one manifold per solve: one sweep lets the first point of a
+# hard impact take all of it and spin the body; a few converge towards the symmetric (block) solution.
+NORMAL_SWEEPS = 4
+
 __all__ = ["ContactRows", "SolverSettings", "prepare_contacts", "solve_contacts", "warm_start_contacts"]
 
 
@@ -53,6 +57,10 @@ class SolverSettings(NamedTuple):
     contact_push_max: float  # [m/s] largest push-out velocity
     restitution_threshold: float  # [m/s] slower impacts do not bounce
     speculative_distance: float  # [m] contacts closer than this are created before touching
+    sleep: bool  # let islands at rest sleep
+    sleep_linear: float  # [m/s] a body slower than this ...
+    sleep_angular: float  # [rad/s] ... and turning slower than this ...
+    time_to_sleep: float  # [s] ... for this long may sleep with its island
 
 
 class ContactRows(NamedTuple):
@@ -68,7 +76,7 @@ class ContactRows(NamedTuple):
     point_count: np.ndarray  # (M,) int64
     anchor_a: np.ndarray  # (M, 4, 3) contact point minus the COM of a at the start of the step
     anchor_b: np.ndarray  # (M, 4, 3)
-    base_separation: np.ndarray  # (M, 4) separation minus n·(anchor_b − anchor_a)
+    base_separation: np.ndarray  # (M, 4) separation at the start of the step
     normal_mass: np.ndarray  # (M, 4) 1 / (n·K n)
     tangent_mass: np.ndarray  # (M, 4, 2)
     normal_impulse: np.ndarray  # (M, 4) accumulated λn of the current substep [N s]
@@ -76,6 +84,8 @@ class ContactRows(NamedTuple):
     max_normal_impulse: np.ndarray  # (M, 4) largest incremental λn of the step (did the point push?)
     relative_velocity: np.ndarray  # (M, 4) normal relative velocity before the step [m/s]
     softness: np.ndarray  # (M, 3) bias_rate, mass_scale, impulse_scale
+    total_normal_impulse: np.ndarray  # (M, 4) λn summed over the substeps and restitution: the step's impulse
+    total_tangent_impulse: np.ndarray  # (M, 4, 2) friction impulse summed over the step
 
     @classmethod
     def allocate(cls, capacity: int) -> ContactRows:
@@ -86,6 +96,7 @@ class ContactRows(NamedTuple):
             np.zeros(capacity, np.int64), np.zeros((capacity, p, 3)), np.zeros((capacity, p, 3)),
             np.zeros((capacity, p)), np.zeros((capacity, p)), np.zeros((capacity, p, 2)), np.zeros((capacity, p)),
             np.zeros((capacity, p, 2)), np.zeros((capacity, p)), np.zeros((capacity, p)), np.zeros((capacity, 3)),
+            np.zeros((capacity, p)), np.zeros((capacity, p, 2)),
         )  # fmt: skip
 
 
@@ -152,7 +163,7 @@ def prepare_contacts(
             ra, rb = sub(p, xa), sub(p, xb)
             store3(rows.anchor_a[m], j, ra)
             store3(rows.anchor_b[m], j, rb)
-            rows.base_separation[m, j] = manifolds.separation[m, j] - dot(sub(rb, ra), n)
+            rows.base_separation[m, j] = manifolds.separation[m, j]
             rows.normal_mass[m, j] = _inverse_effective_mass(ma, ia, ra, mb, ib, rb, n)
             rows.tangent_mass[m, j, 0] = _inverse_effective_mass(ma, ia, ra, mb, ib, rb, t1)
             rows.tangent_mass[m, j, 1] = _inverse_effective_mass(ma, ia, ra, mb, ib, rb, t2)
@@ -161,13 +172,14 @@ def prepare_contacts(
             rows.tangent_impulse[m, j, 0] = dot(warm_t, t1)
             rows.tangent_impulse[m, j, 1] = dot(warm_t, t2)
             rows.max_normal_impulse[m, j] = 0.0
+            rows.total_normal_impulse[m, j] = 0.0
+            rows.total_tangent_impulse[m, j, 0] = rows.total_tangent_impulse[m, j, 1] = 0.0
             rows.relative_velocity[m, j] = dot(_relative_velocity(va, wa, ra, vb, wb, rb), n)
 
 
 @inline
-def _apply_impulse(rows, m, j, impulse, ma, ia, mb, ib, va, wa, vb, wb):
-    """Apply ``impulse`` (world) at point ``j``: ``−P`` to body a, ``+P`` to body b."""
-    ra, rb = load3(rows.anchor_a[m], j), load3(rows.anchor_b[m], j)
+def _apply_impulse(ra, rb, impulse, ma, ia, mb, ib, va, wa, vb, wb):
+    """Apply ``impulse`` (world): ``−P`` to body a at arm ``ra``, ``+P`` to body b at arm ``rb``."""
     va = add_scaled(va, impulse, -ma)
     wa = sub(wa, mat_vec(ia, cross(ra, impulse)))
     vb = add_scaled(vb, impulse, mb)
@@ -175,36 +187,62 @@ def _apply_impulse(rows, m, j, impulse, ma, ia, mb, ib, va, wa, vb, wb):
     return va, wa, vb, wb
 
 
+@inline
+def _motion_since_start(pos, quat, pos0, quat0, i):
+    """How far body ``i``'s COM has moved since the start of the step, and its rotation since then."""
+    q = (quat[i, 0], quat[i, 1], quat[i, 2], quat[i, 3])
+    q0 = (quat0[i, 0], quat0[i, 1], quat0[i, 2], quat0[i, 3])
+    return sub(load3(pos, i), load3(pos0, i)), quat_mul(q, quat_conj(q0))
+
+
+@inline
+def _arms_now(rows, m, j, n, dx_a, dq_a, dx_b, dq_b, weight_b):
+    """Lever arms of point ``j`` now, and its separation now.
+
+    The arms keep their start-of-step directions (Box2D v3: rotating them with the bodies changes the leverage
+    that the effective masses were computed for, and the solver overshoots), but both reach the same world
+    point, so that an impulse exerts no net moment and contacts conserve angular momentum to round-off. That
+    point is the contact point carried along by the bodies' displacements weighted by inverse mass
+    (``weight_b = m_b⁻¹ / (m_a⁻¹ + m_b⁻¹)``): against a static or much heavier body it stays under the light
+    one, as a rolling ball needs. The separation follows the anchors as material points, rotations included.
+    """
+    ra0, rb0 = load3(rows.anchor_a[m], j), load3(rows.anchor_b[m], j)
+    relative = sub(dx_b, dx_a)
+    moved_b = add(dx_b, sub(quat_rotate(dq_b, rb0), rb0))
+    moved_a = add(dx_a, sub(quat_rotate(dq_a, ra0), ra0))
+    separation = rows.base_separation[m, j] + dot(n, sub(moved_b, moved_a))
+    return add_scaled(ra0, relative, weight_b), add_scaled(rb0, relative, weight_b - 1.0), separation
+
+
 @kernel
-def warm_start_contacts(rows, count, inv_mass, inv_inertia_world, linvel, angvel):
+def warm_start_contacts(rows, count, inv_mass, inv_inertia_world, pos, quat, pos0, quat0, linvel, angvel):
     """Re-apply the accumulated impulses of every point (normal and friction).
 
-    Reads: rows.normal_impulse, rows.tangent_impulse. Writes: linvel, angvel.
+    Reads: rows.normal_impulse, rows.tangent_impulse, body poses now and at the start of the step.
+    Writes: linvel, angvel.
     """
     for m in range(count):
+        if rows.normal_mass[m, 0] == 0.0:
+            continue
         a, b = rows.body_a[m], rows.body_b[m]
         ma, mb = inv_mass[a], inv_mass[b]
         ia, ib = load33(inv_inertia_world, a), load33(inv_inertia_world, b)
         va, wa, vb, wb = load3(linvel, a), load3(angvel, a), load3(linvel, b), load3(angvel, b)
+        dx_a, dq_a = _motion_since_start(pos, quat, pos0, quat0, a)
+        dx_b, dq_b = _motion_since_start(pos, quat, pos0, quat0, b)
+        weight_b = mb / (ma + mb)
         n, t1, t2 = load3(rows.normal, m), load3(rows.tangent1, m), load3(rows.tangent2, m)
         for j in range(rows.point_count[m]):
+            ra, rb, _ = _arms_now(rows, m, j, n, dx_a, dq_a, dx_b, dq_b, weight_b)
             impulse = add(
                 scale(n, rows.normal_impulse[m, j]),
                 add(scale(t1, rows.tangent_impulse[m, j, 0]), scale(t2, rows.tangent_impulse[m, j, 1])),
             )
-            va, wa, vb, wb = _apply_impulse(rows, m, j, impulse, ma, ia, mb, ib, va, wa, vb, wb)
+            va, wa, vb, wb = _apply_impulse(ra, rb, impulse, ma, ia, mb, ib, va, wa, vb, wb)
         store3(linvel, a, va)
         store3(angvel, a, wa)
         store3(linvel, b, vb)
         store3(angvel, b, wb)
-
-
-@inline
-def _current_separation(rows, m, j, n, dp_a, dq_a, dp_b, dq_b):
-    """Separation now: the anchors moved with their bodies since the start of the step."""
-    ra = quat_rotate(dq_a, load3(rows.anchor_a[m], j))
-    rb = quat_rotate(dq_b, load3(rows.anchor_b[m], j))
-    return dot(n, sub(add(dp_b, rb), add(dp_a, ra))) + rows.base_separation[m, j]
 
 
 @kernel
@@ -217,36 +255,39 @@ def solve_contacts(
     Writes: rows.normal_impulse, rows.tangent_impulse, rows.max_normal_impulse, linvel, angvel.
     """
     for m in range(count):
+        if rows.normal_mass[m, 0] == 0.0:
+            continue  # neither body moves (static or asleep): keep the impulses it had, for the report and waking
         a, b = rows.body_a[m], rows.body_b[m]
         ma, mb = inv_mass[a], inv_mass[b]
         ia, ib = load33(inv_inertia_world, a), load33(inv_inertia_world, b)
         va, wa, vb, wb = load3(linvel, a), load3(angvel, a), load3(linvel, b), load3(angvel, b)
-        dp_a, dp_b = sub(load3(pos, a), load3(pos0, a)), sub(load3(pos, b), load3(pos0, b))
-        dq_a = quat_mul((quat[a, 0], quat[a, 1], quat[a, 2], quat[a, 3]), quat_conj(
-            (quat0[a, 0], quat0[a, 1], quat0[a, 2], quat0[a, 3])))  # fmt: skip
-        dq_b = quat_mul((quat[b, 0], quat[b, 1], quat[b, 2], quat[b, 3]), quat_conj(
-            (quat0[b, 0], quat0[b, 1], quat0[b, 2], quat0[b, 3])))  # fmt: skip
+        dx_a, dq_a = _motion_since_start(pos, quat, pos0, quat0, a)
+        dx_b, dq_b = _motion_since_start(pos, quat, pos0, quat0, b)
+        weight_b = mb / (ma + mb)
         n, t1, t2 = load3(rows.normal, m), load3(rows.tangent1, m), load3(rows.tangent2, m)
         bias_rate, mass_scale, impulse_scale = rows.softness[m, 0], rows.softness[m, 1], rows.softness[m, 2]
         # Non-penetration: λn ≥ 0, soft towards zero separation; speculative while apart.
-        for j in range(rows.point_count[m]):
-            s = _current_separation(rows, m, j, n, dp_a, dq_a, dp_b, dq_b)
+        for jj in range(NORMAL_SWEEPS * rows.point_count[m]):
+            j = jj % rows.point_count[m]
+            ra, rb, s = _arms_now(rows, m, j, n, dx_a, dq_a, dx_b, dq_b, weight_b)
             bias, m_scale, i_scale = 0.0, 1.0, 0.0
             if s > 0.0:
                 bias = s * inv_h
             elif use_bias:
                 bias, m_scale, i_scale = max(bias_rate * s, -push_max), mass_scale, impulse_scale
-            ra, rb = load3(rows.anchor_a[m], j), load3(rows.anchor_b[m], j)
             vn = dot(_relative_velocity(va, wa, ra, vb, wb, rb), n)
+            if use_bias and rows.max_normal_impulse[m, j] == 0.0:
+                # Not pushed yet this step: the approach speed at the substep of impact is what bounces.
+                rows.relative_velocity[m, j] = min(rows.relative_velocity[m, j], vn)
             old = rows.normal_impulse[m, j]
             new = max(old - rows.normal_mass[m, j] * m_scale * (vn + bias) - i_scale * old, 0.0)
             rows.normal_impulse[m, j] = new
             rows.max_normal_impulse[m, j] = max(rows.max_normal_impulse[m, j], new - old)
-            va, wa, vb, wb = _apply_impulse(rows, m, j, scale(n, new - old), ma, ia, mb, ib, va, wa, vb, wb)
+            va, wa, vb, wb = _apply_impulse(ra, rb, scale(n, new - old), ma, ia, mb, ib, va, wa, vb, wb)
         # Friction: both tangents at once, the accumulated impulse clamped to the Coulomb cone μ λn.
         mu = rows.friction[m]
         for j in range(rows.point_count[m]):
-            ra, rb = load3(rows.anchor_a[m], j), load3(rows.anchor_b[m], j)
+            ra, rb, _ = _arms_now(rows, m, j, n, dx_a, dq_a, dx_b, dq_b, weight_b)
             dv = _relative_velocity(va, wa, ra, vb, wb, rb)
             old1, old2 = rows.tangent_impulse[m, j, 0], rows.tangent_impulse[m, j, 1]
             new1 = old1 - rows.tangent_mass[m, j, 0] * dot(dv, t1)
@@ -258,7 +299,7 @@ def solve_contacts(
                 new1, new2 = new1 * ratio, new2 * ratio
             rows.tangent_impulse[m, j, 0], rows.tangent_impulse[m, j, 1] = new1, new2
             impulse = add(scale(t1, new1 - old1), scale(t2, new2 - old2))
-            va, wa, vb, wb = _apply_impulse(rows, m, j, impulse, ma, ia, mb, ib, va, wa, vb, wb)
+            va, wa, vb, wb = _apply_impulse(ra, rb, impulse, ma, ia, mb, ib, va, wa, vb, wb)
         store3(linvel, a, va)
         store3(angvel, a, wa)
         store3(linvel, b, vb)
@@ -266,31 +307,45 @@ def solve_contacts(
 
 
 @kernel
-def apply_restitution(rows, count, inv_mass, inv_inertia_world, linvel, angvel, threshold):
-    """Bounce: drive the normal velocity to ``−e`` times its value before the step, where it was an impact.
+def apply_restitution(rows, count, inv_mass, inv_inertia_world, pos, quat, pos0, quat0, linvel, angvel, threshold):
+    """Bounce: drive the normal velocity to ``−e`` times its approach velocity, where there was an impact.
 
     Only points that approached faster than ``threshold`` and pushed during the step bounce (Box2D v3).
     Reads: rows.relative_velocity, rows.max_normal_impulse. Writes: rows.normal_impulse, linvel, angvel.
     """
     for m in range(count):
         e = rows.restitution[m]
-        if e == 0.0:
+        if e == 0.0 or rows.normal_mass[m, 0] == 0.0:
             continue
         a, b = rows.body_a[m], rows.body_b[m]
         ma, mb = inv_mass[a], inv_mass[b]
         ia, ib = load33(inv_inertia_world, a), load33(inv_inertia_world, b)
         va, wa, vb, wb = load3(linvel, a), load3(angvel, a), load3(linvel, b), load3(angvel, b)
+        dx_a, dq_a = _motion_since_start(pos, quat, pos0, quat0, a)
+        dx_b, dq_b = _motion_since_start(pos, quat, pos0, quat0, b)
+        weight_b = mb / (ma + mb)
         n = load3(rows.normal, m)
         for j in range(rows.point_count[m]):
             if rows.relative_velocity[m, j] > -threshold or rows.max_normal_impulse[m, j] == 0.0:
                 continue
-            ra, rb = load3(rows.anchor_a[m], j), load3(rows.anchor_b[m], j)
+            ra, rb, _ = _arms_now(rows, m, j, n, dx_a, dq_a, dx_b, dq_b, weight_b)
             vn = dot(_relative_velocity(va, wa, ra, vb, wb, rb), n)
             old = rows.normal_impulse[m, j]
             new = max(old - rows.normal_mass[m, j] * (vn + e * rows.relative_velocity[m, j]), 0.0)
             rows.normal_impulse[m, j] = new
-            va, wa, vb, wb = _apply_impulse(rows, m, j, scale(n, new - old), ma, ia, mb, ib, va, wa, vb, wb)
+            rows.total_normal_impulse[m, j] += new - old
+            va, wa, vb, wb = _apply_impulse(ra, rb, scale(n, new - old), ma, ia, mb, ib, va, wa, vb, wb)
         store3(linvel, a, va)
         store3(angvel, a, wa)
         store3(linvel, b, vb)
         store3(angvel, b, wb)
+
+
+@kernel
+def accumulate_impulses(rows, count):
+    """Add the impulses each point applied during a substep to the step's totals (for ``World.contacts``)."""
+    for m in range(count):
+        for j in range(rows.point_count[m]):
+            rows.total_normal_impulse[m, j] += rows.normal_impulse[m, j]
+            rows.total_tangent_impulse[m, j, 0] += rows.tangent_impulse[m, j, 0]
+            rows.total_tangent_impulse[m, j, 1] += rows.tangent_impulse[m, j, 1]

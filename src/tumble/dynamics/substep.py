@@ -22,7 +22,7 @@ from ..math3d import (
     store4,
     world_inertia_apply,
 )
-from .contact_solver import solve_contacts, warm_start_contacts
+from .contact_solver import accumulate_impulses, solve_contacts, warm_start_contacts
 from .free_motion import implicit_spin
 
 __all__ = ["run_substeps", "to_angular_velocity", "to_angular_momentum"]
@@ -55,10 +55,10 @@ def to_angular_momentum(bodies, quat, angvel, angmom):
 
 
 @kernel
-def integrate_velocities(bodies, gravity, force, torque, quat, linvel, angvel, h):
-    """``v += h (g + F/m)``, implicit gyroscopic spin update, implicit damping; dynamic bodies only."""
+def integrate_velocities(bodies, moving, gravity, force, torque, quat, linvel, angvel, h):
+    """``v += h (g + F/m)``, implicit gyroscopic spin update, implicit damping; moving (awake dynamic) bodies."""
     for i in range(quat.shape[0]):
-        if not bodies.is_dynamic[i]:
+        if not moving[i]:
             continue
         accel = add_scaled((gravity[0], gravity[1], gravity[2]), load3(force, i), bodies.inv_mass[i])
         v = scale(add_scaled(load3(linvel, i), accel, h), 1.0 / (1.0 + h * bodies.linear_damping[i]))
@@ -71,27 +71,29 @@ def integrate_velocities(bodies, gravity, force, torque, quat, linvel, angvel, h
 
 
 @kernel
-def integrate_positions(bodies, linvel, angvel, pos, quat, h):
-    """``x += h v``, ``q ← q + h ½ (0, ω) ⊗ q`` renormalised; dynamic bodies only."""
+def integrate_positions(moving, linvel, angvel, pos, quat, h):
+    """``x += h v``, ``q ← q + h ½ (0, ω) ⊗ q`` renormalised; moving (awake dynamic) bodies."""
     for i in range(pos.shape[0]):
-        if bodies.is_dynamic[i]:
+        if moving[i]:
             store3(pos, i, add_scaled(load3(pos, i), load3(linvel, i), h))
             store4(quat, i, quat_integrate(load4(quat, i), load3(angvel, i), h))
 
 
 @kernel
 def run_substeps(
-    bodies, gravity, force, torque, rows, count, inv_inertia_world, pos, quat, pos0, quat0, linvel, angvel, h,
-    substeps, push_max,
+    bodies, moving, inv_mass, gravity, force, torque, rows, count, inv_inertia_world, pos, quat, pos0, quat0, linvel,
+    angvel, h, substeps, push_max,
 ):  # fmt: skip
     """The soft step's inner loop (Catto 2024): per substep integrate velocities, warm start, solve with a soft
-    bias, integrate positions, relax without bias."""
+    bias, integrate positions, relax without bias. ``inv_mass`` and ``inv_inertia_world`` are zero for bodies
+    that do not move (static or sleeping), which the solver then treats as fixed."""
     inv_h = 1.0 / h
     for _ in range(substeps):
-        integrate_velocities(bodies, gravity, force, torque, quat, linvel, angvel, h)
-        warm_start_contacts(rows, count, bodies.inv_mass, inv_inertia_world, linvel, angvel)
-        solve_contacts(rows, count, bodies.inv_mass, inv_inertia_world, pos, quat, pos0, quat0, linvel, angvel,
-                       inv_h, push_max, True)  # fmt: skip
-        integrate_positions(bodies, linvel, angvel, pos, quat, h)
-        solve_contacts(rows, count, bodies.inv_mass, inv_inertia_world, pos, quat, pos0, quat0, linvel, angvel,
-                       inv_h, push_max, False)  # fmt: skip
+        integrate_velocities(bodies, moving, gravity, force, torque, quat, linvel, angvel, h)
+        warm_start_contacts(rows, count, inv_mass, inv_inertia_world, pos, quat, pos0, quat0, linvel, angvel)
+        solve_contacts(rows, count, inv_mass, inv_inertia_world, pos, quat, pos0, quat0, linvel, angvel, inv_h,
+                       push_max, True)  # fmt: skip
+        integrate_positions(moving, linvel, angvel, pos, quat, h)
+        solve_contacts(rows, count, inv_mass, inv_inertia_world, pos, quat, pos0, quat0, linvel, angvel, inv_h,
+                       push_max, False)  # fmt: skip
+        accumulate_impulses(rows, count)

@@ -1,0 +1,175 @@
+"""Contact against closed-form mechanics: bounce, friction on a ramp, stopping distance, rolling, momentum."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import tumble
+from tumble.rotation import quat_from_axis_angle
+
+G = 9.81
+DT = 1 / 60
+
+
+def ramp_world(theta: float, mu: float):
+    """A plane through the origin tilted by ``theta`` about y (downhill is +x), friction ``mu``."""
+    world = tumble.World()
+    normal = (-np.sin(theta), 0.0, np.cos(theta))
+    world.add_static(tumble.Plane(normal=normal), friction=mu)
+    return world, np.array(normal), np.array([np.cos(theta), 0.0, np.sin(theta)])  # uphill direction
+
+
+def drop_height(restitution: float, h0: float = 1.0) -> float:
+    world = tumble.World()
+    world.add_static(tumble.Plane(), restitution=restitution)
+    ball = world.add_body(tumble.Sphere(0.1), density=1000.0, position=(0, 0, h0 + 0.1), restitution=restitution)
+    traj = world.simulate(1.5 * np.sqrt(2 * h0 / G) * (1 + restitution) + 0.5, DT)
+    z = traj.position[:, ball.index, 2] - 0.1
+    first_impact = int(np.argmax(z < 0.02))  # the first frame at the ground
+    assert first_impact > 0
+    return float(z[first_impact:].max())
+
+
+@pytest.mark.parametrize("restitution", [0.5, 0.8])
+def test_ball_rebounds_to_e_squared_h(restitution):
+    height = drop_height(restitution)
+    # Issue bound 5 %; measured within 1-2 % at 60 Hz (the apex is sampled at 60 Hz).
+    assert height == pytest.approx(restitution**2 * 1.0, rel=0.05)
+
+
+def test_ball_without_restitution_does_not_bounce():
+    assert drop_height(0.0) < 0.005
+
+
+@pytest.mark.parametrize(("theta_deg", "mu"), [(20.0, 0.5), (30.0, 0.7)])
+def test_box_on_a_ramp_holds_when_tan_theta_below_mu(theta_deg, mu):
+    theta = np.radians(theta_deg)
+    assert np.tan(theta) < mu
+    world, normal, _ = ramp_world(theta, mu)
+    q = quat_from_axis_angle((0, 1, 0), -theta)  # tilt the box onto the ramp
+    box = world.add_body(tumble.Box((0.2, 0.2, 0.2)), density=500.0, orientation=q, position=0.1 * normal,
+                         friction=mu)  # fmt: skip
+    world.simulate(0.5, DT)  # settle
+    start = box.position
+    world.simulate(2.0, DT)
+    assert np.linalg.norm(box.position - start) < 1e-3  # issue: drift < 1 mm over 2 s
+
+
+@pytest.mark.parametrize(("theta_deg", "mu"), [(30.0, 0.3), (40.0, 0.2)])
+def test_box_slides_down_a_ramp_at_g_sin_minus_mu_cos(theta_deg, mu):
+    theta = np.radians(theta_deg)
+    world, normal, uphill = ramp_world(theta, mu)
+    q = quat_from_axis_angle((0, 1, 0), -theta)
+    box = world.add_body(tumble.Box((0.2, 0.2, 0.2)), density=500.0, orientation=q, position=0.1 * normal,
+                         friction=mu)  # fmt: skip
+    world.simulate(0.25, DT)
+    traj = world.simulate(1.0, DT)
+    s = -(traj.position[:, box.index] @ uphill)  # distance travelled downhill
+    t = traj.time - traj.time[0]
+    accel = np.polyfit(t, s, 2)[0] * 2
+    expected = G * (np.sin(theta) - mu * np.cos(theta))
+    assert accel == pytest.approx(expected, rel=0.03)  # issue bound 3 %
+
+
+def test_box_sliding_on_the_floor_stops_after_v0_squared_over_2_mu_g():
+    mu, v0 = 0.4, 3.0
+    world = tumble.World()
+    world.add_static(tumble.Plane(), friction=mu)
+    box = world.add_body(tumble.Box((0.2, 0.2, 0.2)), density=500.0, position=(0, 0, 0.1), friction=mu)
+    world.simulate(0.2, DT)  # settle the resting contact first
+    x0 = box.position[0]
+    box.velocity = (v0, 0.0, 0.0)
+    world.simulate(2.0, DT)
+    assert abs(box.velocity[0]) < 1e-3
+    assert box.position[0] - x0 == pytest.approx(v0**2 / (2 * mu * G), rel=0.03)
+
+
+def test_sphere_rolls_down_a_ramp_at_five_sevenths_g_sin_theta():
+    theta, mu = np.radians(20.0), 0.6
+    world, normal, uphill = ramp_world(theta, mu)
+    ball = world.add_body(tumble.Sphere(0.1), density=1000.0, position=0.1 * normal, friction=mu)
+    world.simulate(0.1, DT)
+    traj = world.simulate(1.0, DT)
+    s = -(traj.position[:, ball.index] @ uphill)
+    t = traj.time - traj.time[0]
+    accel = np.polyfit(t, s, 2)[0] * 2
+    assert accel == pytest.approx(5 / 7 * G * np.sin(theta), rel=0.03)  # issue bound 3 %
+    # Rolling without slipping: v = ω r.
+    v = np.linalg.norm(ball.velocity)
+    assert np.linalg.norm(ball.angular_velocity) * 0.1 == pytest.approx(v, rel=0.02)
+
+
+def test_head_on_collision_without_gravity_conserves_momentum():
+    world = tumble.World(gravity=(0, 0, 0))
+    a = world.add_body(tumble.Box((0.2, 0.2, 0.2)), density=1000.0, position=(-0.5, 0.0, 0.0), velocity=(3, 0, 0),
+                       angular_velocity=(0, 1, 0.5), restitution=0.5)  # fmt: skip
+    world.add_body(tumble.Sphere(0.15), density=500.0, position=(0.5, 0.03, 0.0), velocity=(-1, 0, 0), restitution=0.5)
+    p0, L0 = world.linear_momentum(), world.angular_momentum()
+    world.simulate(1.0, DT)
+    assert a.velocity[0] < 3.0  # they did collide
+    np.testing.assert_allclose(world.linear_momentum(), p0, atol=1e-12)  # round-off (measured 4e-15)
+    np.testing.assert_allclose(world.angular_momentum(), L0, atol=1e-11)
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="issue 3, open: touching balls resolve as one simultaneous impact (the soft "
+    "step's restitution pass acts on the striker's contact only); needs sequential impact propagation",
+)
+def test_newtons_cradle_passes_the_momentum_along():
+    world = tumble.World(gravity=(0, 0, 0))
+    r = 0.1
+    balls = [world.add_body(tumble.Sphere(r), density=1000.0, position=(2 * r * k, 0, 0), restitution=1.0)
+             for k in range(5)]  # fmt: skip
+    striker = world.add_body(tumble.Sphere(r), density=1000.0, position=(-0.5, 0, 0), velocity=(2.0, 0, 0),
+                             restitution=1.0)  # fmt: skip
+    world.simulate(1.0, DT)
+    speeds = [b.velocity[0] for b in balls]
+    assert striker.velocity[0] == pytest.approx(0.0, abs=0.05)
+    assert speeds[-1] == pytest.approx(2.0, rel=0.05)
+    assert all(abs(v) < 0.1 for v in speeds[:-1])
+
+
+def test_ten_box_tower_stands():
+    world = tumble.World()
+    world.add_static(tumble.Plane())
+    boxes = [world.add_body(tumble.Box((0.5, 0.5, 0.5)), density=500.0, position=(0, 0, 0.25 + 0.5 * k))
+             for k in range(10)]  # fmt: skip
+    top0 = boxes[-1].position
+    world.simulate(10.0, DT)
+    assert np.linalg.norm(boxes[-1].position - top0) < 0.01  # issue: top moves < 1 cm
+    assert all(np.linalg.norm(b.velocity) < 1e-2 for b in boxes)
+
+
+def test_fast_sphere_does_not_tunnel_through_a_thin_wall():
+    world = tumble.World(gravity=(0, 0, 0))
+    world.add_static(tumble.Box((0.02, 2.0, 2.0)), position=(1.0, 0, 0))
+    ball = world.add_body(tumble.Sphere(0.05), density=1000.0, velocity=(100.0, 0, 0))
+    world.simulate(0.5, DT)
+    assert ball.position[0] < 1.0 - 0.01
+
+
+def test_fast_box_does_not_tunnel_through_a_thin_wall():
+    world = tumble.World(gravity=(0, 0, 0))
+    world.add_static(tumble.Box((0.02, 2.0, 2.0)), position=(1.0, 0, 0))
+    box = world.add_body(tumble.Box((0.1, 0.1, 0.1)), density=1000.0, velocity=(100.0, 0, 0))
+    world.simulate(0.5, DT)
+    assert box.position[0] < 1.0 - 0.01
+
+
+def test_contact_runs_are_bit_identical():
+    def pile():
+        world = tumble.World()
+        world.add_static(tumble.Plane())
+        rng = np.random.default_rng(3)
+        for k in range(20):
+            world.add_body(tumble.Box((0.3, 0.3, 0.3)), density=300.0, position=(rng.uniform(-0.5, 0.5),
+                           rng.uniform(-0.5, 0.5), 0.3 + 0.35 * k))  # fmt: skip
+        return world
+
+    a, b = pile(), pile()
+    a.simulate(2.0, DT)
+    for _ in range(120):
+        b.step(DT)
+    assert a.state.digest() == b.state.digest()
