@@ -941,6 +941,14 @@ def collide_convex_trimesh(geom, shape_a, pos_a, quat_a, shape_b, pos_b, quat_b,
             continue
         # A face contact: the manifold's normal is the triangle's own (not an edge or corner of it).
         n_face = quat_rotate(quat_b, _row(face_normal, f))
+        if dot(n, n_face) > 0.0:
+            # Meshes are one-sided: a shape sunk deep (or straddling the triangle) is never pushed out through the
+            # back, as the least-depth axis of a thin triangle may say; it goes back out along the face normal.
+            v0 = add(pos_b, quat_rotate(quat_b, _row(vertex_local, i0)))
+            k = _front_face_contact(geom, shape_a, pos_a, quat_a, v0, n_face, margin, tri_point, tri_sep, tri_id)
+            if k == 0:
+                continue
+            n = scale(n_face, -1.0)
         on_face = abs(dot(n, n_face)) >= REF_COS
         if m + k > cap:
             m = _squeeze(cand_point, cand_normal, cand_sep, cand_id, cand_face, m)
@@ -955,6 +963,21 @@ def collide_convex_trimesh(geom, shape_a, pos_a, quat_a, shape_b, pos_b, quat_b,
         return 0
     return _merge_mesh_contacts(cand_point, cand_normal, cand_sep, cand_id, cand_face, m, margin, normal, point,
                                 separation, feature)  # fmt: skip
+
+
+@kernel
+def _front_face_contact(geom, shape_a, pos_a, quat_a, v0, n_face, margin, tri_point, tri_sep, tri_id):
+    """One point: shape A's lowest point along the face normal ``n_face`` of a triangle through ``v0``, midway
+    between it and the triangle's plane, and its signed height above the plane; 0 points past ``margin``."""
+    down = scale(n_face, -1.0)
+    lowest = add_scaled(support_world(geom, shape_a, -1, pos_a, quat_a, down), n_face, -core_radius(geom, shape_a, -1))
+    height = dot(sub(lowest, v0), n_face)
+    if height > margin:
+        return 0
+    _set_row(tri_point, 0, add_scaled(lowest, n_face, -0.5 * height))
+    tri_sep[0] = height
+    tri_id[0] = 0
+    return 1
 
 
 @kernel
