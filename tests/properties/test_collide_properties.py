@@ -333,6 +333,39 @@ def test_box_box_depth_is_bracketed_by_the_support_sweep(pair):
         assert c.separation.min() >= bias_bound(best) - SEARCH_TOLERANCE
 
 
+@settings(deadline=None)
+@given(pairs(("Box", "Box")))
+def test_box_box_agrees_with_the_general_convex_path(pair):
+    """The same two boxes through collide_box_box and, as hulls of their corners, through collide_convex_convex:
+    both overlap or neither, and their depths lie within the two paths' axis-preference windows."""
+    from tumble.geometry.collide_convex import (  # noqa: PLC0415  (compiles the convex path)
+        FACE_BIAS,
+        FACE_BIAS_RELATIVE,
+        collide_convex_convex,
+    )
+
+    a, b = pair
+    axes = polytope_axes((a.rotation, a.rotation.T), (b.rotation, b.rotation.T))
+    best = support_separation(corners(a), corners(b), axes)
+    assume(abs(best) > 10 * SEARCH_TOLERANCE)
+    box = collide(a, b, margin=0.0)
+    hulls = [ConvexHull(corners(Posed(body.shape, np.zeros(3), IDENTITY))) for body in (a, b)]
+    geom = pack_geometry(hulls, [0, 1], np.zeros((2, 3)), np.tile(IDENTITY, (2, 1)))
+    normal, point, separation, feature = np.zeros(3), np.zeros((4, 3)), np.zeros(4), np.zeros(4, np.int64)
+    count = collide_convex_convex(geom, 0, tuple(map(float, a.pos)), tuple(map(float, a.quat)), 1,
+                                  tuple(map(float, b.pos)), tuple(map(float, b.quat)), 0.0, normal, point,
+                                  separation, feature)  # fmt: skip
+    assert (box.count > 0) == (count > 0) == (best < 0.0)
+    if count:
+        high = best + PREFERENCE + SEARCH_TOLERANCE
+        assert bias_bound(best) - SEARCH_TOLERANCE <= box.separation.min() <= high
+        # The hull path's preference window scales with the pair's size (FACE_BIAS of the two bounding radii).
+        size = sum(np.linalg.norm(body.shape.half_extents) for body in (a, b))
+        gap = best - FACE_BIAS * size
+        hull_bound = gap / (1.0 - FACE_BIAS_RELATIVE) if gap < 0.0 else gap / (1.0 + FACE_BIAS_RELATIVE)
+        assert hull_bound - SEARCH_TOLERANCE <= separation[:count].min() <= high
+
+
 def lowest_on_plane(a: Posed, plane: Posed) -> float:
     """Signed distance of a shape's lowest point from the plane, from the shape's own description."""
     n = plane.rotation @ plane.shape.normal
