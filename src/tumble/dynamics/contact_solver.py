@@ -214,6 +214,26 @@ def _arms_now(rows, m, j, n, dx_a, dq_a, dx_b, dq_b, weight_b):
     return add_scaled(ra0, relative, weight_b), add_scaled(rb0, relative, weight_b - 1.0), separation
 
 
+@inline
+def _load_pair(rows, m, inv_mass, inv_inertia_world, pos, quat, pos0, quat0, linvel, angvel):
+    """What the solver needs of manifold ``m``'s two bodies: indices, inverse masses and world inverse inertias,
+    velocities, motion since the start of the step, and b's share of the inverse mass."""
+    a, b = rows.body_a[m], rows.body_b[m]
+    ma, mb = inv_mass[a], inv_mass[b]
+    dx_a, dq_a = _motion_since_start(pos, quat, pos0, quat0, a)
+    dx_b, dq_b = _motion_since_start(pos, quat, pos0, quat0, b)
+    return (a, b, ma, load33(inv_inertia_world, a), mb, load33(inv_inertia_world, b), load3(linvel, a),
+            load3(angvel, a), load3(linvel, b), load3(angvel, b), dx_a, dq_a, dx_b, dq_b, mb / (ma + mb))  # fmt: skip
+
+
+@inline
+def _store_pair(linvel, angvel, a, b, va, wa, vb, wb):
+    store3(linvel, a, va)
+    store3(angvel, a, wa)
+    store3(linvel, b, vb)
+    store3(angvel, b, wb)
+
+
 @kernel
 def warm_start_contacts(rows, count, inv_mass, inv_inertia_world, pos, quat, pos0, quat0, linvel, angvel):
     """Re-apply the accumulated impulses of every point (normal and friction).
@@ -224,13 +244,9 @@ def warm_start_contacts(rows, count, inv_mass, inv_inertia_world, pos, quat, pos
     for m in range(count):
         if rows.normal_mass[m, 0] == 0.0:
             continue
-        a, b = rows.body_a[m], rows.body_b[m]
-        ma, mb = inv_mass[a], inv_mass[b]
-        ia, ib = load33(inv_inertia_world, a), load33(inv_inertia_world, b)
-        va, wa, vb, wb = load3(linvel, a), load3(angvel, a), load3(linvel, b), load3(angvel, b)
-        dx_a, dq_a = _motion_since_start(pos, quat, pos0, quat0, a)
-        dx_b, dq_b = _motion_since_start(pos, quat, pos0, quat0, b)
-        weight_b = mb / (ma + mb)
+        a, b, ma, ia, mb, ib, va, wa, vb, wb, dx_a, dq_a, dx_b, dq_b, weight_b = _load_pair(
+            rows, m, inv_mass, inv_inertia_world, pos, quat, pos0, quat0, linvel, angvel
+        )
         n, t1, t2 = load3(rows.normal, m), load3(rows.tangent1, m), load3(rows.tangent2, m)
         for j in range(rows.point_count[m]):
             ra, rb, _ = _arms_now(rows, m, j, n, dx_a, dq_a, dx_b, dq_b, weight_b)
@@ -239,10 +255,7 @@ def warm_start_contacts(rows, count, inv_mass, inv_inertia_world, pos, quat, pos
                 add(scale(t1, rows.tangent_impulse[m, j, 0]), scale(t2, rows.tangent_impulse[m, j, 1])),
             )
             va, wa, vb, wb = _apply_impulse(ra, rb, impulse, ma, ia, mb, ib, va, wa, vb, wb)
-        store3(linvel, a, va)
-        store3(angvel, a, wa)
-        store3(linvel, b, vb)
-        store3(angvel, b, wb)
+        _store_pair(linvel, angvel, a, b, va, wa, vb, wb)
 
 
 @kernel
@@ -257,13 +270,9 @@ def solve_contacts(
     for m in range(count):
         if rows.normal_mass[m, 0] == 0.0:
             continue  # neither body moves (static or asleep): keep the impulses it had, for the report and waking
-        a, b = rows.body_a[m], rows.body_b[m]
-        ma, mb = inv_mass[a], inv_mass[b]
-        ia, ib = load33(inv_inertia_world, a), load33(inv_inertia_world, b)
-        va, wa, vb, wb = load3(linvel, a), load3(angvel, a), load3(linvel, b), load3(angvel, b)
-        dx_a, dq_a = _motion_since_start(pos, quat, pos0, quat0, a)
-        dx_b, dq_b = _motion_since_start(pos, quat, pos0, quat0, b)
-        weight_b = mb / (ma + mb)
+        a, b, ma, ia, mb, ib, va, wa, vb, wb, dx_a, dq_a, dx_b, dq_b, weight_b = _load_pair(
+            rows, m, inv_mass, inv_inertia_world, pos, quat, pos0, quat0, linvel, angvel
+        )
         n, t1, t2 = load3(rows.normal, m), load3(rows.tangent1, m), load3(rows.tangent2, m)
         bias_rate, mass_scale, impulse_scale = rows.softness[m, 0], rows.softness[m, 1], rows.softness[m, 2]
         # Non-penetration: λn ≥ 0, soft towards zero separation; speculative while apart.
@@ -300,10 +309,7 @@ def solve_contacts(
             rows.tangent_impulse[m, j, 0], rows.tangent_impulse[m, j, 1] = new1, new2
             impulse = add(scale(t1, new1 - old1), scale(t2, new2 - old2))
             va, wa, vb, wb = _apply_impulse(ra, rb, impulse, ma, ia, mb, ib, va, wa, vb, wb)
-        store3(linvel, a, va)
-        store3(angvel, a, wa)
-        store3(linvel, b, vb)
-        store3(angvel, b, wb)
+        _store_pair(linvel, angvel, a, b, va, wa, vb, wb)
 
 
 @kernel
@@ -317,13 +323,9 @@ def apply_restitution(rows, count, inv_mass, inv_inertia_world, pos, quat, pos0,
         e = rows.restitution[m]
         if e == 0.0 or rows.normal_mass[m, 0] == 0.0:
             continue
-        a, b = rows.body_a[m], rows.body_b[m]
-        ma, mb = inv_mass[a], inv_mass[b]
-        ia, ib = load33(inv_inertia_world, a), load33(inv_inertia_world, b)
-        va, wa, vb, wb = load3(linvel, a), load3(angvel, a), load3(linvel, b), load3(angvel, b)
-        dx_a, dq_a = _motion_since_start(pos, quat, pos0, quat0, a)
-        dx_b, dq_b = _motion_since_start(pos, quat, pos0, quat0, b)
-        weight_b = mb / (ma + mb)
+        a, b, ma, ia, mb, ib, va, wa, vb, wb, dx_a, dq_a, dx_b, dq_b, weight_b = _load_pair(
+            rows, m, inv_mass, inv_inertia_world, pos, quat, pos0, quat0, linvel, angvel
+        )
         n = load3(rows.normal, m)
         for j in range(rows.point_count[m]):
             if rows.relative_velocity[m, j] > -threshold or rows.max_normal_impulse[m, j] == 0.0:
@@ -335,10 +337,7 @@ def apply_restitution(rows, count, inv_mass, inv_inertia_world, pos, quat, pos0,
             rows.normal_impulse[m, j] = new
             rows.total_normal_impulse[m, j] += new - old
             va, wa, vb, wb = _apply_impulse(ra, rb, scale(n, new - old), ma, ia, mb, ib, va, wa, vb, wb)
-        store3(linvel, a, va)
-        store3(angvel, a, wa)
-        store3(linvel, b, vb)
-        store3(angvel, b, wb)
+        _store_pair(linvel, angvel, a, b, va, wa, vb, wb)
 
 
 @kernel
