@@ -30,7 +30,7 @@ import numpy as np
 import scipy.spatial
 
 from . import mass as _mass
-from ._validate import as_array, as_float, as_vector3
+from ._validate import _show, as_array, as_float, as_vector3
 
 __all__ = [
     "ShapeType",
@@ -351,6 +351,20 @@ def _hull_extent_check(points: np.ndarray) -> float:
     return size
 
 
+def _flatness(points: np.ndarray) -> str:
+    """How degenerate points are that Qhull refused: "collinear", "coplanar" or "nearly flat".
+
+    The singular values of the centred points measure their spread along three orthogonal directions; 1e-10 of
+    the largest is far below any real thickness and far above the round-off of the SVD (~1e-16).
+    """
+    spread = np.linalg.svd(points - points.mean(axis=0), compute_uv=False)
+    if spread[1] <= 1e-10 * spread[0]:
+        return "collinear"
+    if spread[2] <= 1e-10 * spread[0]:
+        return "coplanar"
+    return "nearly flat"
+
+
 class ConvexHull(Shape):
     """The convex hull of ``points`` (n, 3) [m], computed with Qhull (``scipy.spatial.ConvexHull``).
 
@@ -365,15 +379,17 @@ class ConvexHull(Shape):
     def __init__(self, points) -> None:
         pts = as_array("points", points, (3,), batch=True)
         if pts.ndim != 2 or pts.shape[0] < 4:
-            raise ValueError(f"points must have shape (n, 3) with n >= 4 to span a volume, got shape {pts.shape}")
+            raise ValueError(
+                f"points must have shape (n, 3) with n >= 4 to span a volume, got shape {pts.shape}: {_show(pts)}"
+            )
         size = _hull_extent_check(pts)
         try:
             hull = scipy.spatial.ConvexHull(pts)
         except scipy.spatial.QhullError as error:
             reason = str(error).strip().splitlines()[0] if str(error).strip() else "no volume"
             raise ValueError(
-                f"points must span a volume, but they are coplanar, collinear or otherwise degenerate "
-                f"({len(pts)} points; Qhull: {reason})"
+                f"points must span a volume, but the {len(pts)} points are {_flatness(pts)}: {_show(pts)} "
+                f"(Qhull: {reason})"
             ) from error
         corners = np.sort(hull.vertices)
         remap = np.full(len(pts), -1, dtype=np.int64)

@@ -42,9 +42,41 @@ def _check_integrator(integrator) -> str:
 
 
 def _check_filter(name: str, bits) -> int:
-    if isinstance(bits, bool) or not isinstance(bits, (int, np.integer)) or not 0 <= int(bits) <= 0xFFFFFFFF:
-        raise ValueError(f"{name} must be an integer of 32 bits (0 to 0xFFFFFFFF), got {bits!r}")
+    if isinstance(bits, (bool, np.bool_)) or not isinstance(bits, (int, np.integer)):
+        raise TypeError(f"{name} must be an integer of 32 bits (0 to 0xFFFFFFFF), got {bits!r} ({type(bits).__name__})")
+    if not 0 <= int(bits) <= 0xFFFFFFFF:
+        raise ValueError(f"{name} must be an integer of 32 bits (0 to 0xFFFFFFFF), got {int(bits)}")
     return int(bits)
+
+
+def _check_dynamic_shapes(shape) -> None:
+    """Refuse planes and meshes in a dynamic body: a plane has no mass, and the contact kernels collide meshes as
+    fixed geometry only (convex shapes against a mesh, never a mesh against a mesh or a plane)."""
+    if shape is None:
+        return
+    items = (
+        [("shape", shape)] if isinstance(shape, Shape) else [(f"shape[{k}]", item[0]) for k, item in enumerate(shape)]
+    )
+    for label, item in items:
+        if isinstance(item, (Plane, TriMesh)):
+            kind = type(item).__name__
+            raise ValueError(
+                f"{label} cannot be a {kind} in a dynamic body: a {kind} can only be static (use world.add_static, "
+                f"or a ConvexHull for a dynamic body), got {item!r}"
+            )
+
+
+def _check_query_shape(shape) -> Shape:
+    if not isinstance(shape, Shape):
+        raise TypeError(
+            f"shape must be a Sphere, Box, Capsule, Cylinder or ConvexHull, got {shape!r} ({type(shape).__name__})"
+        )
+    if isinstance(shape, (Plane, TriMesh)):
+        raise ValueError(
+            f"shape must be a Sphere, Box, Capsule, Cylinder or ConvexHull (a convex solid) to query overlaps, "
+            f"got {shape!r}"
+        )
+    return shape
 
 
 def _shape_items(shape, friction: float, restitution: float, group: int = 1, mask: int = 0xFFFFFFFF) -> list[ShapeSpec]:
@@ -78,12 +110,6 @@ def _body_mass_properties(items: list[ShapeSpec], mass, density, inertia) -> Mas
                 f"got mass={mass!r}, inertia={inertia!r}"
             )
         return MassProperties(as_float("mass", mass, positive=True), np.zeros(3), inertia)
-    for k, item in enumerate(items):
-        if isinstance(item.shape, (Plane, TriMesh)):
-            raise ValueError(
-                f"shape[{k}]: a {type(item.shape).__name__} can only be static; use world.add_static "
-                "(or ConvexHull for a dynamic body)"
-            )
     kind, value = mass_or_density(mass, density)
     per_volume = value if kind == "density" else 1.0
     mp = sum(
@@ -186,6 +212,7 @@ class World:
         name = self._check_name(name)
         group, mask = _check_filter("collision_group", collision_group), _check_filter("collision_mask", collision_mask)
         items = _shape_items(shape, friction, restitution, group, mask)
+        _check_dynamic_shapes(shape)
         mp = _body_mass_properties(items, mass, density, inertia)
         _require_definite(mp)
         com = position + quat_rotate(quat, mp.com)
@@ -317,7 +344,9 @@ class World:
             if key not in current:
                 raise TypeError(f"unknown solver setting {key!r}; settings: {sorted(current)}")
             if key == "substeps":
-                if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
+                if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)):
+                    raise TypeError(f"substeps must be an integer >= 1, got {value!r} ({type(value).__name__})")
+                if value < 1:
                     raise ValueError(f"substeps must be an integer >= 1, got {value!r}")
                 current[key] = int(value)
             elif key == "sleep":
@@ -471,6 +500,34 @@ class World:
             return None
         body = self._bodies[int(model.shape_body[shape])]
         return RayHit(body, int(shape), float(distance), np.array(point), np.array(normal))
+
+    def query_overlap(
+        self, shape, position=(0.0, 0.0, 0.0), orientation=(1.0, 0.0, 0.0, 0.0), *, mask: int = 0xFFFFFFFF
+    ) -> list[Body]:
+        """Every body with a shape that overlaps ``shape`` placed at ``position`` and ``orientation``, by index.
+
+        ``shape`` is a :class:`~tumble.Sphere`, :class:`~tumble.Box`, :class:`~tumble.Capsule`,
+        :class:`~tumble.Cylinder` or :class:`~tumble.ConvexHull`; its frame is put at the pose (world frame), as
+        :meth:`add_static` would put it. The contact kernels of the step decide: two shapes overlap when their
+        manifold has a point with separation <= 0, so shapes that just touch count. Static bodies count; only
+        shapes whose ``collision_group`` shares a bit with ``mask`` are tested. A plane is a solid half-space, a
+        :class:`~tumble.TriMesh` a surface: a shape wholly inside a closed mesh does not overlap it.
+
+        Returns:
+            The bodies, sorted by :attr:`Body.index`, each once (empty when nothing overlaps).
+        """
+        from .geometry.overlap import overlapping_shapes
+
+        shape = _check_query_shape(shape)
+        position = as_vector3("position", position)
+        quat = as_quaternion("orientation", orientation)
+        mask = _check_filter("mask", mask)
+        model, state = self.model, self._state
+        rows = overlapping_shapes(
+            model.geometry, state.body_pos, state.body_quat, model.shape_group, mask, shape, position, quat
+        )
+        indices = np.unique(model.shape_body[rows])
+        return [self._bodies[int(i)] for i in indices]
 
     def __repr__(self) -> str:
         dynamic = sum(1 for b in self._bodies if not b.is_static)
