@@ -108,3 +108,59 @@ def test_mujoco_free_body_angular_velocity_is_set_in_the_body_frame():
         velocity = np.zeros(6)
         mujoco.mj_objectVelocity(model, data, mujoco.mjtObj.mjOBJ_BODY, i + 1, velocity, 0)
         np.testing.assert_allclose(velocity[:3], omega_world[i], atol=1e-12)
+
+
+# --- contact benchmarks (benchmarks/contact.py) ----------------------------------------------------------
+
+CONTACT_TINY = run.Sizes(
+    repeat=1, pile_boxes=8, pile_seconds=0.05, pyramid_base=3, pyramid_seconds=0.05, cubes_boxes=(4,),
+    cubes_seconds=0.05, big_pyramid_base=3, big_pyramid_seconds=0.05,
+)  # fmt: skip
+
+
+def _contact_rows_are_sane(rows: list[dict], bodies: int) -> None:
+    _assert_finite_numbers(rows)
+    assert {(r["engine"], r["hz"]) for r in rows if r["engine"] == "tumble"} == {("tumble", 60), ("tumble", 240)}
+    for r in rows:
+        assert r["bodies"] == bodies
+        assert r["steps_per_s"] > 0 and r["realtime_x"] > 0
+        assert r["below_ground"] == 0
+        assert r["notes"] == "", r["notes"]
+
+
+def test_contact_pile_and_pyramid_rows_for_tumble():
+    """Runs with or without the peers; tumble's rows are there either way."""
+    rows = run.BENCHMARKS["pile"](CONTACT_TINY)
+    _contact_rows_are_sane(rows, 8)
+    pyramid = run.BENCHMARKS["pyramid"](CONTACT_TINY)
+    _contact_rows_are_sane(pyramid, 6)
+    assert all(r["top_drift_mm"] < 10 for r in pyramid)
+    big = run.BENCHMARKS["big_pyramid"](CONTACT_TINY)
+    assert [(r["engine"], r["hz"]) for r in big] == [("tumble", 60)]
+    assert "big_pyramid" in run.OPTIONAL
+
+
+def test_contact_rows_for_the_peers():
+    pytest.importorskip("mujoco")
+    pytest.importorskip("pybullet")
+    rows = run.BENCHMARKS["cubes"](CONTACT_TINY)
+    _contact_rows_are_sane(rows, 4)
+    assert {r["engine"] for r in rows} == {"tumble", "MuJoCo", "PyBullet"}
+    assert all("x_mujoco" in r and "x_pybullet" in r for r in rows)
+    assert max(r["x_pybullet"] for r in rows if r["engine"] == "PyBullet") == pytest.approx(1.0)
+
+
+def test_contact_targets_in_quick_mode(tmp_path):
+    code = run.main(["--quick", "--only", "pile", "--only", "pyramid", "--csv", str(tmp_path), "--machine", "smoke"])
+    assert code == 0
+    assert (tmp_path / "smoke" / "pile.csv").read_text().startswith("scene,bodies,engine,hz")
+    targets = (tmp_path / "smoke" / "targets.csv").read_text()
+    assert "pile 27, tumble 60 Hz: max penetration (mm)" in targets
+    assert "pyramid 10, tumble 60 Hz: top drift (mm)" in targets
+
+
+def test_box_corners_and_mujoco_penetration_helpers():
+    quat = np.array([[1.0, 0.0, 0.0, 0.0], [np.cos(np.pi / 8), np.sin(np.pi / 8), 0.0, 0.0]])
+    low = peers.box_vertices_min_z([[0.0, 0.0, 0.1], [0.0, 0.0, 0.1]], quat, [0.1, 0.1, 0.1])
+    np.testing.assert_allclose(low, [0.0, 0.1 - 0.1 * np.sqrt(2.0)], atol=1e-12)
+    assert "type='plane'" in peers.boxes_on_plane_mjcf([[0.0, 0.0, 0.1]], [[1.0, 0.0, 0.0, 0.0]], 0.1, 1.0)

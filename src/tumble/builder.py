@@ -13,6 +13,7 @@ import numpy as np
 from .geometry.packing import pack_geometry
 from .mass import MassProperties
 from .model import Model
+from .shapes import Capsule, Cylinder, Sphere
 
 __all__ = ["ModelBuilder", "ShapeSpec"]
 
@@ -26,6 +27,7 @@ class ShapeSpec:
     quat: np.ndarray  # (4,) [w, x, y, z]
     friction: float
     restitution: float
+    rolling_resistance: float = 0.0  # coefficient c: torque c N r opposes rolling (r: the shape's radius)
     group: int = 1  # collision filter bits: a and b collide iff (group_a & mask_b) and (group_b & mask_a)
     mask: int = 0xFFFFFFFF
 
@@ -95,6 +97,8 @@ class ModelBuilder:
             ),
             shape_friction=np.array([s.friction for _, s in specs], dtype=np.float64),
             shape_restitution=np.array([s.restitution for _, s in specs], dtype=np.float64),
+            shape_rolling=np.array([s.rolling_resistance * _rolling_radius(s.shape) for _, s in specs], np.float64),
+            shape_core_radius=np.array([_core_radius(s.shape) for _, s in specs], np.float64),
             shape_group=np.array([s.group for _, s in specs], dtype=np.uint32),
             shape_mask=np.array([s.mask for _, s in specs], dtype=np.uint32),
             has_contacts=_contacts_possible(specs, is_dynamic),
@@ -121,3 +125,13 @@ def _contacts_possible(specs: list[tuple[int, ShapeSpec]], is_dynamic: np.ndarra
             if (group_a & mask_b) and (group_b & mask_a) and (dynamic_a or dynamic_b) and len(bodies_a | bodies_b) > 1:
                 return True
     return False
+
+
+def _rolling_radius(shape) -> float:
+    """The radius a shape rolls on (sphere, capsule, cylinder); 0 for shapes that do not roll."""
+    return float(getattr(shape, "radius", 0.0)) if isinstance(shape, (Sphere, Capsule, Cylinder)) else 0.0
+
+
+def _core_radius(shape) -> float:
+    """The radius swept round a sphere's centre or a capsule's segment; 0 for the other shapes."""
+    return float(shape.radius) if isinstance(shape, (Sphere, Capsule)) else 0.0

@@ -47,6 +47,8 @@ class Model:
             ``model.shape_body``, ``shape_type``, ``shape_params``, ``shape_pos_local`` and ``shape_quat_local``
             read from it.
         shape_friction, shape_restitution: (shape_count,) float64.
+        shape_rolling: (shape_count,) float64 [m], rolling resistance times the shape's rolling radius.
+        shape_core_radius: (shape_count,) float64 [m], a sphere's or capsule's radius round its core, else 0.
         shape_group, shape_mask: (shape_count,) uint32 collision filter bits.
         has_contacts: whether two shapes of different bodies can touch (then the contact solver steps).
         shapes: the shape objects, in row order (for geometry that does not fit the arrays).
@@ -65,6 +67,8 @@ class Model:
     geometry: GeometryArrays
     shape_friction: np.ndarray
     shape_restitution: np.ndarray
+    shape_rolling: np.ndarray
+    shape_core_radius: np.ndarray
     shape_group: np.ndarray
     shape_mask: np.ndarray
     has_contacts: bool

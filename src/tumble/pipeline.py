@@ -190,6 +190,8 @@ def contact_step(model: Model, state: State, inputs: Inputs, params: Params, scr
         geom.shape_body,
         model.shape_friction,
         model.shape_restitution,
+        model.shape_rolling,
+        model.shape_core_radius,
         inv_mass,
         inv_inertia_world,
         state.body_pos,

@@ -79,12 +79,14 @@ def _check_query_shape(shape) -> Shape:
     return shape
 
 
-def _shape_items(shape, friction: float, restitution: float, group: int = 1, mask: int = 0xFFFFFFFF) -> list[ShapeSpec]:
-    """``None``, one shape, or a list of ``(shape, position[, orientation])`` in the body frame."""
+def _shape_items(shape, material: tuple[float, float, float], group: int = 1, mask: int = 0xFFFFFFFF
+                 ) -> list[ShapeSpec]:  # fmt: skip
+    """``None``, one shape, or a list of ``(shape, position[, orientation])`` in the body frame; ``material`` is
+    ``(friction, restitution, rolling_resistance)``."""
     if shape is None:
         return []
     if isinstance(shape, Shape):
-        return [ShapeSpec(shape, np.zeros(3), _IDENTITY.copy(), friction, restitution, group, mask)]
+        return [ShapeSpec(shape, np.zeros(3), _IDENTITY.copy(), *material, group=group, mask=mask)]
     if not isinstance(shape, Sequence) or isinstance(shape, str) or len(shape) == 0:
         raise TypeError(
             f"shape must be a Shape, a non-empty list of (shape, position[, orientation]) or None, got {shape!r}"
@@ -95,7 +97,7 @@ def _shape_items(shape, friction: float, restitution: float, group: int = 1, mas
             raise TypeError(f"shape[{k}] must be (shape, position[, orientation]), got {item!r}")
         position = as_vector3(f"shape[{k}] position", item[1])
         quat = as_quaternion(f"shape[{k}] orientation", item[2]) if len(item) == 3 else _IDENTITY.copy()
-        items.append(ShapeSpec(item[0], position, quat, friction, restitution, group, mask))
+        items.append(ShapeSpec(item[0], position, quat, *material, group=group, mask=mask))
     return items
 
 
@@ -189,6 +191,7 @@ class World:
         angular_velocity=(0.0, 0.0, 0.0),
         friction: float = 0.5,
         restitution: float = 0.0,
+        rolling_resistance: float = 0.0,
         linear_damping: float = 0.0,
         angular_damping: float = 0.0,
         collision_group: int = 1,
@@ -200,18 +203,21 @@ class World:
         ``shape`` is a :class:`~tumble.Shape`, a list of ``(shape, position[, orientation])`` in the body frame
         (a compound body), or ``None`` with ``mass=`` and ``inertia=``. Two shapes collide when
         ``collision_group & other.collision_mask`` and ``other.collision_group & collision_mask`` are both
-        non-zero; ``collision_mask=0`` turns collisions off for this body.
+        non-zero; ``collision_mask=0`` turns collisions off for this body. ``friction`` (Coulomb μ, mixed as
+        ``√(μa μb)``), ``restitution`` (in [0, 1], mixed as the larger) and ``rolling_resistance`` (the coefficient
+        ``c`` of a resisting torque ``c N r`` on round shapes of radius ``r``, mixed as the larger) apply to all
+        of the body's shapes; see ``docs/contact.md``.
         """
         position = as_vector3("position", position)
         quat = as_quaternion("orientation", orientation)
         velocity = as_vector3("velocity", velocity)
         angular_velocity = as_vector3("angular_velocity", angular_velocity)
-        friction, restitution = self._check_material(friction, restitution)
+        material = self._check_material(friction, restitution, rolling_resistance)
         linear_damping = as_float("linear_damping", linear_damping, nonnegative=True)
         angular_damping = as_float("angular_damping", angular_damping, nonnegative=True)
         name = self._check_name(name)
         group, mask = _check_filter("collision_group", collision_group), _check_filter("collision_mask", collision_mask)
-        items = _shape_items(shape, friction, restitution, group, mask)
+        items = _shape_items(shape, material, group, mask)
         _check_dynamic_shapes(shape)
         mp = _body_mass_properties(items, mass, density, inertia)
         _require_definite(mp)
@@ -230,6 +236,7 @@ class World:
         orientation=(1.0, 0.0, 0.0, 0.0),
         friction: float = 0.5,
         restitution: float = 0.0,
+        rolling_resistance: float = 0.0,
         collision_group: int = 1,
         collision_mask: int = 0xFFFFFFFF,
         name: str | None = None,
@@ -239,20 +246,20 @@ class World:
             raise TypeError("add_static needs a shape, got None")
         position = as_vector3("position", position)
         quat = as_quaternion("orientation", orientation)
-        friction, restitution = self._check_material(friction, restitution)
+        material = self._check_material(friction, restitution, rolling_resistance)
         name = self._check_name(name)
         group, mask = _check_filter("collision_group", collision_group), _check_filter("collision_mask", collision_mask)
-        items = _shape_items(shape, friction, restitution, group, mask)
+        items = _shape_items(shape, material, group, mask)
         index = self._builder.add_body(None, items, name=name)
         return self._append(index, position, quat, np.zeros(3), np.zeros(3))
 
     @staticmethod
-    def _check_material(friction, restitution) -> tuple[float, float]:
+    def _check_material(friction, restitution, rolling_resistance) -> tuple[float, float, float]:
         friction = as_float("friction", friction, nonnegative=True)
         restitution = as_float("restitution", restitution, nonnegative=True)
         if restitution > 1.0:
             raise ValueError(f"restitution must be in [0, 1], got {restitution!r}")
-        return friction, restitution
+        return friction, restitution, as_float("rolling_resistance", rolling_resistance, nonnegative=True)
 
     def _check_name(self, name) -> str | None:
         if name is None:

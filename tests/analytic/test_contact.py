@@ -85,6 +85,30 @@ def test_box_sliding_on_the_floor_stops_after_v0_squared_over_2_mu_g():
     assert box.position[0] - x0 == pytest.approx(v0**2 / (2 * mu * G), rel=0.03)
 
 
+@pytest.mark.parametrize("c", [0.02, 0.05])
+def test_a_ball_with_rolling_resistance_stops_after_v0_squared_over_two_five_sevenths_c_g(c):
+    # A resisting moment c N r on a ball rolling without slipping: (I + m r²) ω' = -c m g r, so a = -(5/7) c g.
+    v0, r = 2.0, 0.1
+    world = tumble.World()
+    world.add_static(tumble.Plane(), friction=0.8)
+    ball = world.add_body(tumble.Sphere(r), density=1000.0, position=(0, 0, r), friction=0.8, rolling_resistance=c)
+    world.simulate(0.1, DT)  # settle
+    x0 = ball.position[0]
+    ball.velocity, ball.angular_velocity = (v0, 0.0, 0.0), (0.0, v0 / r, 0.0)
+    world.simulate(v0 / (5 / 7 * c * G) + 1.0, DT)
+    assert np.linalg.norm(ball.velocity) < 1e-3
+    assert ball.position[0] - x0 == pytest.approx(v0**2 / (2 * 5 / 7 * c * G), rel=0.03)
+
+
+def test_without_rolling_resistance_a_rolling_ball_keeps_rolling():
+    world = tumble.World()
+    world.add_static(tumble.Plane())
+    ball = world.add_body(tumble.Sphere(0.1), density=1000.0, position=(0, 0, 0.1))
+    ball.velocity, ball.angular_velocity = (2.0, 0.0, 0.0), (0.0, 20.0, 0.0)
+    world.simulate(2.0, DT)
+    assert ball.velocity[0] == pytest.approx(2.0, rel=1e-3)
+
+
 def test_sphere_rolls_down_a_ramp_at_five_sevenths_g_sin_theta():
     theta, mu = np.radians(20.0), 0.6
     world, normal, uphill = ramp_world(theta, mu)

@@ -12,7 +12,8 @@ from tunnelling through each other.
 
 Each contact point has a normal impulse ``λn ≥ 0`` and a friction impulse in the tangent plane bounded by the
 Coulomb cone ``|λt| ≤ μ λn`` (two tangent directions, clamped as a vector). Friction mixes as ``√(μa μb)``,
-restitution as ``max(ea, eb)``.
+restitution as ``max(ea, eb)``. Optional rolling resistance (Box2D v3's, about both tangents) bounds an angular
+impulse against relative rolling by ``c r Σλn``, mixed as the larger ``c r`` of the two shapes.
 """
 
 from __future__ import annotations
@@ -86,6 +87,10 @@ class ContactRows(NamedTuple):
     softness: np.ndarray  # (M, 3) bias_rate, mass_scale, impulse_scale
     total_normal_impulse: np.ndarray  # (M, 4) λn summed over the substeps and restitution: the step's impulse
     total_tangent_impulse: np.ndarray  # (M, 4, 2) friction impulse summed over the step
+    rolling: np.ndarray  # (M,) [m] rolling resistance lever c r (the larger of the two shapes')
+    rolling_mass: np.ndarray  # (M, 2) 1 / (t·(I_a⁻¹ + I_b⁻¹) t) about tangent1, tangent2
+    rolling_impulse: np.ndarray  # (M, 2) accumulated angular impulse about tangent1, tangent2 [N m s]
+    core_radius: np.ndarray  # (M, 2) radius round the core of a and b (sphere, capsule), else 0 [m]
 
     @classmethod
     def allocate(cls, capacity: int) -> ContactRows:
@@ -96,7 +101,8 @@ class ContactRows(NamedTuple):
             np.zeros(capacity, np.int64), np.zeros((capacity, p, 3)), np.zeros((capacity, p, 3)),
             np.zeros((capacity, p)), np.zeros((capacity, p)), np.zeros((capacity, p, 2)), np.zeros((capacity, p)),
             np.zeros((capacity, p, 2)), np.zeros((capacity, p)), np.zeros((capacity, p)), np.zeros((capacity, 3)),
-            np.zeros((capacity, p)), np.zeros((capacity, p, 2)),
+            np.zeros((capacity, p)), np.zeros((capacity, p, 2)), np.zeros(capacity), np.zeros((capacity, 2)),
+            np.zeros((capacity, 2)), np.zeros((capacity, 2)),
         )  # fmt: skip
 
 
@@ -122,6 +128,23 @@ def _inverse_effective_mass(inv_mass_a, inv_i_a, r_a, inv_mass_b, inv_i_b, r_b, 
 
 
 @inline
+def _inverse_angular_mass(inv_i_a, inv_i_b, axis):
+    """``1 / (axis·(I_a⁻¹ + I_b⁻¹) axis)`` of an angular constraint about ``axis``, 0 if neither body turns."""
+    k = dot(axis, mat_vec(inv_i_a, axis)) + dot(axis, mat_vec(inv_i_b, axis))
+    return 1.0 / k if k > 0.0 else 0.0
+
+
+@inline
+def _clamp_to_disc(x, y, limit):
+    """``(x, y)`` scaled back onto the disc of radius ``limit`` if it lies outside (a Coulomb-type bound)."""
+    length = math.sqrt(x * x + y * y)
+    if length > limit:
+        ratio = limit / length
+        return x * ratio, y * ratio
+    return x, y
+
+
+@inline
 def _relative_velocity(v_a, w_a, r_a, v_b, w_b, r_b):
     """Velocity of b's contact point relative to a's: ``v_b + ω_b × r_b − v_a − ω_a × r_a``."""
     return sub(add(v_b, cross(w_b, r_b)), add(v_a, cross(w_a, r_a)))
@@ -129,7 +152,8 @@ def _relative_velocity(v_a, w_a, r_a, v_b, w_b, r_b):
 
 @kernel
 def prepare_contacts(
-    manifolds, count, shape_body, shape_friction, shape_restitution, inv_mass, inv_inertia_world, pos, linvel,
+    manifolds, count, shape_body, shape_friction, shape_restitution, shape_rolling, shape_core_radius, inv_mass,
+    inv_inertia_world, pos, linvel,
     angvel, warm_normal, warm_tangent, contact_hertz, damping_ratio, h, rows,
 ):  # fmt: skip
     """Anchors, effective masses, softness and warm-start impulses of every manifold.
@@ -149,6 +173,9 @@ def prepare_contacts(
         store3(rows.tangent2, m, t2)
         rows.friction[m] = math.sqrt(shape_friction[manifolds.shape_a[m]] * shape_friction[manifolds.shape_b[m]])
         rows.restitution[m] = max(shape_restitution[manifolds.shape_a[m]], shape_restitution[manifolds.shape_b[m]])
+        rows.rolling[m] = max(shape_rolling[manifolds.shape_a[m]], shape_rolling[manifolds.shape_b[m]])
+        rows.core_radius[m, 0] = shape_core_radius[manifolds.shape_a[m]]
+        rows.core_radius[m, 1] = shape_core_radius[manifolds.shape_b[m]]
         # A contact against a static body is stiffer (2x), as it has half the effective mass to move.
         hertz = contact_hertz if inv_mass[a] > 0.0 and inv_mass[b] > 0.0 else 2.0 * contact_hertz
         bias_rate, mass_scale, impulse_scale = soft_coefficients(hertz, damping_ratio, h)
@@ -158,6 +185,10 @@ def prepare_contacts(
         va, wa, vb, wb = load3(linvel, a), load3(angvel, a), load3(linvel, b), load3(angvel, b)
         xa, xb = load3(pos, a), load3(pos, b)
         rows.point_count[m] = manifolds.point_count[m]
+        rows.rolling_impulse[m, 0] = rows.rolling_impulse[m, 1] = 0.0
+        if rows.rolling[m] > 0.0:
+            rows.rolling_mass[m, 0] = _inverse_angular_mass(ia, ib, t1)
+            rows.rolling_mass[m, 1] = _inverse_angular_mass(ia, ib, t2)
         for j in range(manifolds.point_count[m]):
             p = load3(manifolds.point[m], j)
             ra, rb = sub(p, xa), sub(p, xb)
@@ -204,12 +235,15 @@ def _arms_now(rows, m, j, n, dx_a, dq_a, dx_b, dq_b, weight_b):
     point, so that an impulse exerts no net moment and contacts conserve angular momentum to round-off. That
     point is the contact point carried along by the bodies' displacements weighted by inverse mass
     (``weight_b = m_b⁻¹ / (m_a⁻¹ + m_b⁻¹)``): against a static or much heavier body it stays under the light
-    one, as a rolling ball needs. The separation follows the anchors as material points, rotations included.
+    one, as a rolling ball needs. The separation follows the anchors as material points, rotations included,
+    except for the part of an anchor that crosses a sphere's or capsule's radius: the surface of a rolling ball
+    stays under its centre, so a turning ball does not seem to lift off the ground.
     """
     ra0, rb0 = load3(rows.anchor_a[m], j), load3(rows.anchor_b[m], j)
     relative = sub(dx_b, dx_a)
-    moved_b = add(dx_b, sub(quat_rotate(dq_b, rb0), rb0))
-    moved_a = add(dx_a, sub(quat_rotate(dq_a, ra0), ra0))
+    core_a, core_b = add_scaled(ra0, n, -rows.core_radius[m, 0]), add_scaled(rb0, n, rows.core_radius[m, 1])
+    moved_b = add(dx_b, sub(quat_rotate(dq_b, core_b), core_b))
+    moved_a = add(dx_a, sub(quat_rotate(dq_a, core_a), core_a))
     separation = rows.base_separation[m, j] + dot(n, sub(moved_b, moved_a))
     return add_scaled(ra0, relative, weight_b), add_scaled(rb0, relative, weight_b - 1.0), separation
 
@@ -255,6 +289,8 @@ def warm_start_contacts(rows, count, inv_mass, inv_inertia_world, pos, quat, pos
                 add(scale(t1, rows.tangent_impulse[m, j, 0]), scale(t2, rows.tangent_impulse[m, j, 1])),
             )
             va, wa, vb, wb = _apply_impulse(ra, rb, impulse, ma, ia, mb, ib, va, wa, vb, wb)
+        moment = add(scale(t1, rows.rolling_impulse[m, 0]), scale(t2, rows.rolling_impulse[m, 1]))
+        wa, wb = sub(wa, mat_vec(ia, moment)), add(wb, mat_vec(ib, moment))
         _store_pair(linvel, angvel, a, b, va, wa, vb, wb)
 
 
@@ -301,14 +337,24 @@ def solve_contacts(
             old1, old2 = rows.tangent_impulse[m, j, 0], rows.tangent_impulse[m, j, 1]
             new1 = old1 - rows.tangent_mass[m, j, 0] * dot(dv, t1)
             new2 = old2 - rows.tangent_mass[m, j, 1] * dot(dv, t2)
-            limit = mu * rows.normal_impulse[m, j]
-            length = math.sqrt(new1 * new1 + new2 * new2)
-            if length > limit:
-                ratio = limit / length
-                new1, new2 = new1 * ratio, new2 * ratio
+            new1, new2 = _clamp_to_disc(new1, new2, mu * rows.normal_impulse[m, j])
             rows.tangent_impulse[m, j, 0], rows.tangent_impulse[m, j, 1] = new1, new2
             impulse = add(scale(t1, new1 - old1), scale(t2, new2 - old2))
             va, wa, vb, wb = _apply_impulse(ra, rb, impulse, ma, ia, mb, ib, va, wa, vb, wb)
+        # Rolling resistance (Box2D v3's, about both tangents): an angular impulse against the relative rolling,
+        # bounded by c r Σλn, the moment of a resisting force c N at the rolling radius r.
+        if rows.rolling[m] > 0.0:
+            total = 0.0
+            for j in range(rows.point_count[m]):
+                total += rows.normal_impulse[m, j]
+            dw = sub(wb, wa)
+            old1, old2 = rows.rolling_impulse[m, 0], rows.rolling_impulse[m, 1]
+            limit = rows.rolling[m] * total
+            new1, new2 = _clamp_to_disc(old1 - rows.rolling_mass[m, 0] * dot(dw, t1),
+                                        old2 - rows.rolling_mass[m, 1] * dot(dw, t2), limit)  # fmt: skip
+            rows.rolling_impulse[m, 0], rows.rolling_impulse[m, 1] = new1, new2
+            moment = add(scale(t1, new1 - old1), scale(t2, new2 - old2))
+            wa, wb = sub(wa, mat_vec(ia, moment)), add(wb, mat_vec(ib, moment))
         _store_pair(linvel, angvel, a, b, va, wa, vb, wb)
 
 
