@@ -14,6 +14,13 @@ import numpy as np
 
 __all__ = [
     "angular_momentum_world",
+    "box_vertices_min_z",
+    "boxes_on_plane_mjcf",
+    "have_pybullet",
+    "mujoco_max_penetration",
+    "pybullet_boxes_on_plane",
+    "pybullet_max_penetration",
+    "pybullet_state",
     "free_bodies_mjcf",
     "free_body_arrays",
     "grid_positions",
@@ -160,3 +167,151 @@ def angular_momentum_world(quat, inertia_diag, omega_body) -> np.ndarray:
     """``L = R (I ω_body)`` (..., 3), world frame, from body-frame spin and orientation ``quat``."""
     omega_body = np.asarray(omega_body, dtype=float)
     return _rotate(np.asarray(quat, dtype=float), np.asarray(inertia_diag, dtype=float) * omega_body)
+
+
+# --- contact scenes: boxes on a ground plane (MuJoCo and PyBullet) ----------------------------------------
+
+
+def have_pybullet() -> bool:
+    try:
+        import pybullet  # noqa: F401
+    except ImportError:
+        return False
+    return True
+
+
+def _boxes(positions, quats, half_extents, masses):
+    positions = np.asarray(positions, dtype=float).reshape(-1, 3)
+    n = positions.shape[0]
+    quats = np.asarray(quats, dtype=float).reshape(n, 4)
+    half_extents = np.broadcast_to(np.asarray(half_extents, dtype=float), (n, 3))
+    masses = np.broadcast_to(np.asarray(masses, dtype=float), (n,))
+    return positions, quats, half_extents, masses
+
+
+def boxes_on_plane_mjcf(
+    positions,
+    quats,
+    half_extents,
+    masses,
+    timestep: float = 1 / 240,
+    friction: float = 0.5,
+    gravity=(0.0, 0.0, -9.81),
+    solver: str = "Newton",
+    memory_mb: int | None = None,
+) -> str:
+    """Free-joint boxes (solid, uniform: MuJoCo derives the inertia from ``mass``) over an infinite plane at z = 0.
+
+    ``quats`` are ``[w, x, y, z]`` (MuJoCo's order, as tumble's). Every geom has sliding friction ``friction``
+    (MuJoCo combines two geoms' frictions by their maximum, so a contact gets ``friction``); everything else
+    is MuJoCo's default (pyramidal cones, soft contacts with solref 0.02, Euler integrator). The arena is
+    sized from the box count (about 256 KiB a box: contacts, constraint rows and the Newton solver's factor)
+    unless ``memory_mb`` is given.
+    """
+    positions, quats, half_extents, masses = _boxes(positions, quats, half_extents, masses)
+    n = positions.shape[0]
+    memory_mb = memory_mb if memory_mb is not None else 64 + n // 4
+    material = f"friction='{float(friction)!r} 0.005 0.0001'"
+    bodies = "".join(
+        f"<body name='box{i}' pos='{_vec(p)}' quat='{_vec(q)}'><freejoint/>"
+        f"<geom type='box' size='{_vec(h)}' mass='{float(m)!r}' {material}/></body>"
+        for i, (p, q, h, m) in enumerate(zip(positions, quats, half_extents, masses, strict=True))
+    )
+    return (
+        "<mujoco model='boxes_on_plane'>"
+        f"<size memory='{int(memory_mb)}M'/>"
+        f"<option timestep='{float(timestep)!r}' gravity='{_vec(gravity)}' solver='{solver}'/>"
+        f"<worldbody><geom name='ground' type='plane' size='0 0 1' {material}/>{bodies}</worldbody>"
+        "</mujoco>"
+    )
+
+
+def mujoco_max_penetration(data) -> float:
+    """The deepest overlap among MuJoCo's active contacts [m] (``-min(dist)``, 0 when nothing overlaps)."""
+    if data.ncon == 0:
+        return 0.0
+    return max(0.0, -float(np.min(data.contact.dist[: data.ncon])))
+
+
+def pybullet_boxes_on_plane(
+    positions,
+    quats,
+    half_extents,
+    masses,
+    timestep: float = 1 / 240,
+    friction: float = 0.5,
+    gravity=(0.0, 0.0, -9.81),
+    maximal_coordinates: bool = False,
+):
+    """A PyBullet ``DIRECT`` client with a static plane at z = 0 and one box multibody per row.
+
+    Returns ``(client, body_ids)``; disconnect with ``pybullet.disconnect(client)``. ``quats`` are
+    ``[w, x, y, z]`` (converted to PyBullet's ``[x, y, z, w]``). Bullet multiplies the two bodies' lateral
+    frictions, so each body gets ``sqrt(friction)`` and a contact gets ``friction``. Solver settings are
+    PyBullet's defaults (50 iterations); ``maximal_coordinates`` makes plain rigid bodies instead of
+    (reduced-coordinate) multibodies.
+    """
+    import pybullet as p
+
+    positions, quats, half_extents, masses = _boxes(positions, quats, half_extents, masses)
+    client = p.connect(p.DIRECT)
+    try:
+        p.setGravity(*(float(g) for g in gravity), physicsClientId=client)
+        p.setTimeStep(float(timestep), physicsClientId=client)
+        per_body = float(np.sqrt(friction))
+        plane = p.createMultiBody(0.0, p.createCollisionShape(p.GEOM_PLANE, physicsClientId=client),
+                                  physicsClientId=client)  # fmt: skip
+        p.changeDynamics(plane, -1, lateralFriction=per_body, physicsClientId=client)
+        shapes: dict[tuple[float, ...], int] = {}
+        ids = []
+        for position, q, half, mass in zip(positions, quats, half_extents, masses, strict=True):
+            key = tuple(half.tolist())
+            if key not in shapes:
+                shapes[key] = p.createCollisionShape(p.GEOM_BOX, halfExtents=list(key), physicsClientId=client)
+            body = p.createMultiBody(
+                float(mass),
+                shapes[key],
+                basePosition=position.tolist(),
+                baseOrientation=[q[1], q[2], q[3], q[0]],
+                useMaximalCoordinates=maximal_coordinates,
+                physicsClientId=client,
+            )
+            p.changeDynamics(body, -1, lateralFriction=per_body, physicsClientId=client)
+            ids.append(body)
+    except Exception:
+        p.disconnect(client)
+        raise
+    return client, ids
+
+
+def pybullet_state(client, body_ids) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(position (n, 3), quat (n, 4) [w, x, y, z], velocity (n, 3))`` of the bodies (COM = box centre)."""
+    import pybullet as p
+
+    positions, quats, velocities = [], [], []
+    for body in body_ids:
+        position, q = p.getBasePositionAndOrientation(body, physicsClientId=client)
+        velocity, _ = p.getBaseVelocity(body, physicsClientId=client)
+        positions.append(position)
+        quats.append((q[3], q[0], q[1], q[2]))
+        velocities.append(velocity)
+    return np.array(positions), np.array(quats), np.array(velocities)
+
+
+def pybullet_max_penetration(client) -> float:
+    """The deepest overlap among PyBullet's contact points [m] (``-min(contactDistance)``, 0 when none overlap)."""
+    import pybullet as p
+
+    points = p.getContactPoints(physicsClientId=client)
+    if not points:
+        return 0.0
+    return max(0.0, -min(point[8] for point in points))
+
+
+def box_vertices_min_z(positions, quats, half_extents) -> np.ndarray:
+    """(n,) the lowest z of each box's eight corners [m]: how far below a ground at z = 0 a box reaches."""
+    positions, quats, half_extents, _ = _boxes(positions, quats, half_extents, 1.0)
+    signs = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)], dtype=float)
+    corners = signs[None, :, :] * half_extents[:, None, :]  # (n, 8, 3), body frame
+    world = _rotate(quats[:, None, :], corners) + positions[:, None, :]
+    return world[..., 2].min(axis=1)

@@ -9,6 +9,9 @@ Run from the repository root:
 ``many_bodies``  4096 free spheres under gravity in one world, no collisions: body-steps per second.
 ``cold_start``   ``import tumble`` and the first ``step``/``simulate`` in a fresh process, Numba cache cold
                  and warm.
+``pile``, ``pyramid``, ``cubes``, ``big_pyramid``
+                 contact scenes, tumble against MuJoCo and PyBullet (``benchmarks/contact.py``); ``big_pyramid``
+                 (5050 boxes, tumble only) runs only when asked for with ``--only``.
 
 Every timing is the best of ``--repeat`` runs after a first call that is reported apart (it includes the
 JIT compile or the load from Numba's disk cache). Both engines run in the same process, so compare the
@@ -38,11 +41,12 @@ import numpy as np
 
 import tumble
 
-from . import peers
+from . import contact, peers
 
 __all__ = [
     "BENCHMARKS",
     "FULL",
+    "OPTIONAL",
     "QUICK",
     "Sizes",
     "bench_cold_start",
@@ -76,12 +80,21 @@ class Sizes:
     repeat: int = 7
     cold_start: bool = True
     cold_start_bodies: int = 64
+    pile_boxes: int = 1000  # contact benchmarks (benchmarks/contact.py)
+    pile_seconds: float = 3.0
+    pyramid_base: int = 20
+    pyramid_seconds: float = 10.0
+    cubes_boxes: tuple[int, ...] = (64, 512)
+    cubes_seconds: float = 3.0
+    big_pyramid_base: int = 100
+    big_pyramid_seconds: float = 2.0
 
 
 FULL = Sizes()
 QUICK = Sizes(
     tumbling_steps=200, record_every=100, bodies=64, body_steps=50, mujoco_seconds=0.02, repeat=1,
-    cold_start=False, cold_start_bodies=8,
+    cold_start=False, cold_start_bodies=8, pile_boxes=27, pile_seconds=0.2, pyramid_base=4, pyramid_seconds=0.2,
+    cubes_boxes=(8, 27), cubes_seconds=0.2, big_pyramid_base=6, big_pyramid_seconds=0.2,
 )  # fmt: skip
 
 
@@ -540,12 +553,40 @@ def check_targets(results: dict[str, list[dict]]) -> list[dict]:
         if row is not None and "x_mujoco" in row:
             label = f"{row['bodies']} bodies, {integrator}, {threads} threads vs MuJoCo Euler (x)"
             add(label, row["x_mujoco"], ">= 10", row["x_mujoco"] >= 10)
+    targets += _contact_targets(results)
     for row in results.get("cold_start", []):
         if row["order"] != "step first":
             continue
         limit = 1.5 if row["cache"] == "warm" else 20.0
         add(f"{row['cache']} start: import + first step (s)", row["import_plus_step_s"], f"< {limit:g}",
             row["import_plus_step_s"] < limit)  # fmt: skip
+    return targets
+
+
+def _contact_targets(results: dict[str, list[dict]]) -> list[dict]:
+    """The contact issue's targets: tumble at 60 Hz against the peers at 240 Hz, on the pile and the pyramid."""
+    targets = []
+
+    def add(name, value, limit, met):
+        targets.append({"target": name, "value": value, "limit": limit, "met": "yes" if met else "NO"})
+
+    pile = _find(results.get("pile", []), engine="tumble", hz=60)
+    if pile is not None:
+        label = f"pile {pile['bodies']}, tumble 60 Hz"
+        if "x_mujoco" in pile:
+            add(f"{label}: real-time factor vs MuJoCo (x)", pile["x_mujoco"], ">= 2", pile["x_mujoco"] >= 2)
+        if "x_pybullet" in pile:
+            add(f"{label}: real-time factor vs PyBullet (x)", pile["x_pybullet"], ">= 5", pile["x_pybullet"] >= 5)
+        add(f"{label}: max speed at the end (m/s)", pile["max_speed"], f"< {contact.SETTLED_SPEED:g} (settled)",
+            pile["settled"])  # fmt: skip
+        add(f"{label}: max penetration (mm)", pile["max_penetration_mm"], "< 5", pile["max_penetration_mm"] < 5)
+        add(f"{label}: boxes below the ground", pile["below_ground"], "0", pile["below_ground"] == 0)
+    pyramid = _find(results.get("pyramid", []), engine="tumble", hz=60)
+    if pyramid is not None:
+        label = f"pyramid {pyramid['bodies']}, tumble 60 Hz"
+        add(f"{label}: top drift (mm)", pyramid["top_drift_mm"], "< 10", pyramid["top_drift_mm"] < 10)
+        if "x_mujoco" in pyramid:
+            add(f"{label}: real-time factor vs MuJoCo (x)", pyramid["x_mujoco"], ">= 2", pyramid["x_mujoco"] >= 2)
     return targets
 
 
@@ -596,7 +637,12 @@ BENCHMARKS: dict[str, Callable[[Sizes], list[dict]]] = {
     "tumbling": bench_tumbling,
     "many_bodies": bench_many_bodies,
     "cold_start": bench_cold_start,
+    "pile": contact.bench_pile,
+    "pyramid": contact.bench_pyramid,
+    "cubes": contact.bench_cubes,
+    "big_pyramid": contact.bench_big_pyramid,
 }
+OPTIONAL = ("big_pyramid",)  # slow: run only when asked for with --only
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -612,7 +658,7 @@ def main(argv: list[str] | None = None) -> int:
     sizes = QUICK if args.quick else FULL
     if args.repeat is not None:
         sizes = Sizes(**{**sizes.__dict__, "repeat": max(1, args.repeat)})
-    names = args.only or [n for n in BENCHMARKS if sizes.cold_start or n != "cold_start"]
+    names = args.only or [n for n in BENCHMARKS if n not in OPTIONAL and (sizes.cold_start or n != "cold_start")]
 
     info = machine_info()
     print("machine:", ", ".join(f"{k}={v}" for k, v in info.items()), flush=True)
