@@ -183,6 +183,7 @@ def prepare_contacts(
         rows.core_radius[m, 1] = shape_core_radius[manifolds.shape_b[m]]
         # A contact against a static body is stiffer (2x), as it has half the effective mass to move.
         hertz = contact_hertz if inv_mass[a] > 0.0 and inv_mass[b] > 0.0 else 2.0 * contact_hertz
+        hertz = min(hertz, 0.25 / h)  # Box2D's bound: a quarter of the substep rate (h ω <= π/2)
         bias_rate, mass_scale, impulse_scale = soft_coefficients(hertz, damping_ratio, h)
         rows.softness[m, 0], rows.softness[m, 1], rows.softness[m, 2] = bias_rate, mass_scale, impulse_scale
         ma, mb = inv_mass[a], inv_mass[b]
