@@ -679,10 +679,20 @@ def main(argv: list[str] | None = None) -> int:
         for name, rows in results.items():
             write_csv(folder / f"{name}.csv", rows)
         if targets:
-            write_csv(folder / "targets.csv", targets)
+            write_csv(folder / "targets.csv", _merged_targets(folder / "targets.csv", targets))
         write_csv(folder / "machine.csv", [{"key": k, "value": v} for k, v in info.items()])
         print(f"\nwrote {folder}/")
     return 0
+
+
+def _merged_targets(path: Path, targets: list[dict]) -> list[dict]:
+    """The targets just checked, after those of earlier runs of other benchmarks (a run with ``--only`` keeps them)."""
+    fresh = {t["target"] for t in targets}
+    earlier = []
+    if path.is_file():
+        with path.open(newline="") as f:
+            earlier = [row for row in csv.DictReader(f) if row["target"] not in fresh]
+    return earlier + targets
 
 
 if __name__ == "__main__":
