@@ -15,6 +15,7 @@ Bodies with contacts (the soft step of DESIGN.md):
     prepare_contacts      manifolds, bodies      -> scratch.rows           (dynamics/contact_solver.py)
     run_substeps          integrate v, warm start, solve, integrate x, relax   (dynamics/substep.py)
     apply_restitution     rows                   -> velocities             (dynamics/contact_solver.py)
+    limit_to_impact       pairs, poses           -> poses of fast bodies   (geometry/toi.py)
     store impulses        rows                   -> state.contact_*        (here)
     update_sleep          manifolds, velocities  -> state.body_sleep_*     (dynamics/islands.py)
     to_angular_momentum   scratch.body_angvel    -> state.body_angmom      (dynamics/substep.py)
@@ -32,6 +33,7 @@ from .dynamics.islands import update_sleep, wake_touched
 from .dynamics.substep import run_substeps, to_angular_momentum, to_angular_velocity
 from .geometry.broad_phase import find_pairs, update_aabbs
 from .geometry.narrow_phase import collide_pairs, match_warm_start
+from .geometry.toi import limit_to_impact
 from .inputs import Inputs
 from .model import Model
 from .params import Integrator, Params
@@ -227,6 +229,8 @@ def contact_step(model: Model, state: State, inputs: Inputs, params: Params, scr
     )
     apply_restitution(rows, count, inv_mass, inv_inertia_world, state.body_pos, state.body_quat, pos0, quat0,
                       state.body_linvel, angvel, settings.restitution_threshold)  # fmt: skip
+    # Fast bodies that would have passed into static geometry stop at their first touch.
+    limit_to_impact(geom, model.body_is_dynamic, pairs_a, pairs_b, pos0, quat0, state.body_pos, state.body_quat)
     _store_impulses(state, manifolds, rows, count)
     scratch.contact_count = count
     # Islands whose bodies have all been still long enough go to sleep.

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import tumble
-from tumble.rotation import quat_from_axis_angle
+from tumble.rotation import quat_from_axis_angle, quat_to_matrix
 
 G = 9.81
 DT = 1 / 60
@@ -197,3 +197,47 @@ def test_contact_runs_are_bit_identical():
     for _ in range(120):
         b.step(DT)
     assert a.state.digest() == b.state.digest()
+
+
+def _crosses_wall(shape, speed, wall_angle_deg, spin) -> bool:
+    """Whether a spinning body fired at a slanted 2 cm static wall ever passes from its near side to its far side
+    between two frames (within the wall's extent)."""
+    world = tumble.World(gravity=(0, 0, 0))
+    turn = quat_from_axis_angle((0, 0, 1), np.radians(wall_angle_deg))
+    world.add_static(tumble.Box((0.02, 2.0, 2.0)), position=(1.0, 0, 0), orientation=turn)
+    body = world.add_body(shape, density=1000.0, velocity=(speed, 0, 0), angular_velocity=spin)
+    traj = world.simulate(0.3, DT)
+    rotation = quat_to_matrix(turn)
+    relative = traj.position[:, body.index] - (1.0, 0.0, 0.0)
+    depth, across = relative @ rotation[:, 0], relative @ rotation[:, 1]
+    inside = (np.abs(across[1:]) < 1.0) & (np.abs(relative[1:, 2]) < 1.0)
+    return bool(np.any((depth[:-1] < 0.0) & (depth[1:] > 0.0) & inside))
+
+
+SPINNING = {
+    "box": (tumble.Box((0.1, 0.1, 0.1)), (0.0, 0.0, 30.0)),
+    "capsule": (tumble.Capsule(0.03, 0.2), (0.0, 50.0, 0.0)),
+    "hull": (tumble.ConvexHull(np.random.default_rng(0).normal(size=(10, 3)) * 0.05), (20.0, 0.0, 40.0)),
+    "cylinder": (tumble.Cylinder(0.04, 0.1), (20.0, 0.0, 40.0)),
+}
+
+
+@pytest.mark.parametrize("name", sorted(SPINNING))
+@pytest.mark.parametrize("wall_angle_deg", [0.0, 30.0, 60.0])
+def test_spinning_bodies_at_30_m_per_s_do_not_tunnel_through_a_slanted_wall(name, wall_angle_deg):
+    # Speculative contacts alone let the cylinder through at every angle, and the others at 100 m/s: the time of
+    # impact sweep (geometry/toi.py) stops them.
+    if name == "cylinder" and wall_angle_deg == 30.0:
+        pytest.xfail(
+            "issue 3, open: spun up to 180 rad/s by the first impact, the cylinder works its way through the "
+            "wall over several steps while the contact cannot hold it (its core is in the wall by then)"
+        )
+    shape, spin = SPINNING[name]
+    assert not _crosses_wall(shape, 30.0, wall_angle_deg, spin)
+
+
+@pytest.mark.parametrize("name", ["box", "capsule", "hull"])
+@pytest.mark.parametrize("wall_angle_deg", [30.0, 45.0, 60.0])
+def test_spinning_bodies_at_100_m_per_s_do_not_tunnel_through_a_slanted_wall(name, wall_angle_deg):
+    shape, spin = SPINNING[name]
+    assert not _crosses_wall(shape, 100.0, wall_angle_deg, spin)
