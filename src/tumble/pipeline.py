@@ -13,7 +13,7 @@ Bodies with contacts (the soft step of DESIGN.md):
     match_warm_start      state.contact_*        -> scratch.warm_*         (geometry/narrow_phase.py)
     wake_touched          manifolds              -> state.body_sleeping    (dynamics/islands.py)
     prepare_contacts      manifolds, bodies      -> scratch.rows           (dynamics/contact_solver.py)
-    run_substeps          integrate v, warm start, solve, integrate x, relax   (dynamics/substep.py)
+    run_substeps          integrate v, ball impacts, warm start, solve, integrate x, relax (dynamics/substep.py)
     apply_restitution     rows                   -> velocities             (dynamics/contact_solver.py)
     limit_to_impact       pairs, poses           -> poses of fast bodies   (geometry/toi.py)
     store impulses        rows                   -> state.contact_*        (here)
@@ -226,6 +226,7 @@ def contact_step(model: Model, state: State, inputs: Inputs, params: Params, scr
         h,
         settings.substeps,
         settings.contact_push_max,
+        settings.restitution_threshold,
     )
     apply_restitution(rows, count, inv_mass, inv_inertia_world, state.body_pos, state.body_quat, pos0, quat0,
                       state.body_linvel, angvel, settings.restitution_threshold)  # fmt: skip

@@ -369,6 +369,40 @@ def solve_contacts(
 
 
 @kernel
+def resolve_impacts(rows, count, inv_mass, inv_inertia_world, pos, quat, pos0, quat0, linvel, angvel, h, threshold):
+    """Bounce single-point impacts (balls) as they happen, one after the other, so momentum passes along a row.
+
+    Called at the start of a substep: a one-point contact with restitution ``e`` that closes faster than
+    ``threshold`` and will touch within the substep gets the fresh impulse that turns its normal velocity ``vn``
+    into ``-e vn``; sweeps repeat while any such contact remains (a struck ball then strikes the next: Newton's
+    cradle). Resolving them inside the substeps' inelastic solve instead would merge a touching row into one
+    body. Manifolds of several points bounce after the substeps (:func:`apply_restitution`), where one corner
+    cannot take the whole impact. Writes: linvel, angvel.
+    """
+    for _ in range(count + 1):
+        bounced = False
+        for m in range(count):
+            e = rows.restitution[m]
+            if e == 0.0 or rows.point_count[m] != 1 or rows.normal_mass[m, 0] == 0.0:
+                continue
+            a, b, ma, ia, mb, ib, va, wa, vb, wb, dx_a, dq_a, dx_b, dq_b, weight_b = _load_pair(
+                rows, m, inv_mass, inv_inertia_world, pos, quat, pos0, quat0, linvel, angvel
+            )
+            n = load3(rows.normal, m)
+            ra, rb, s = _arms_now(rows, m, 0, n, dx_a, dq_a, dx_b, dq_b, weight_b)
+            vn = dot(_relative_velocity(va, wa, ra, vb, wb, rb), n)
+            if vn >= -threshold or s > -vn * h + 1e-9:  # (1 nm: a gap that closes exactly at the substep's end)
+                continue
+            impulse = scale(n, -(1.0 + e) * rows.normal_mass[m, 0] * vn)
+            va, wa, vb, wb = _apply_impulse(ra, rb, impulse, ma, ia, mb, ib, va, wa, vb, wb)
+            _store_pair(linvel, angvel, a, b, va, wa, vb, wb)
+            rows.relative_velocity[m, 0] = 0.0  # bounced: the pass after the substeps leaves it alone
+            bounced = True
+        if not bounced:
+            break
+
+
+@kernel
 def apply_restitution(rows, count, inv_mass, inv_inertia_world, pos, quat, pos0, quat0, linvel, angvel, threshold):
     """Bounce: drive the normal velocity to ``−e`` times its approach velocity, where there was an impact.
 

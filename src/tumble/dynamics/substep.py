@@ -22,7 +22,7 @@ from ..math3d import (
     store4,
     world_inertia_apply,
 )
-from .contact_solver import accumulate_impulses, solve_contacts, warm_start_contacts
+from .contact_solver import accumulate_impulses, resolve_impacts, solve_contacts, warm_start_contacts
 from .free_motion import implicit_spin
 
 __all__ = ["run_substeps", "to_angular_velocity", "to_angular_momentum"]
@@ -82,14 +82,16 @@ def integrate_positions(moving, linvel, angvel, pos, quat, h):
 @kernel
 def run_substeps(
     bodies, moving, inv_mass, gravity, force, torque, rows, count, inv_inertia_world, pos, quat, pos0, quat0, linvel,
-    angvel, h, substeps, push_max,
+    angvel, h, substeps, push_max, threshold,
 ):  # fmt: skip
-    """The soft step's inner loop (Catto 2024): per substep integrate velocities, warm start, solve with a soft
-    bias, integrate positions, relax without bias. ``inv_mass`` and ``inv_inertia_world`` are zero for bodies
+    """The soft step's inner loop (Catto 2024): per substep integrate velocities, bounce the ball impacts of the
+    substep, warm start, solve with a soft bias, integrate positions, relax without bias. ``inv_mass`` and
+    ``inv_inertia_world`` are zero for bodies
     that do not move (static or sleeping), which the solver then treats as fixed."""
     inv_h = 1.0 / h
     for _ in range(substeps):
         integrate_velocities(bodies, moving, gravity, force, torque, quat, linvel, angvel, h)
+        resolve_impacts(rows, count, inv_mass, inv_inertia_world, pos, quat, pos0, quat0, linvel, angvel, h, threshold)
         warm_start_contacts(rows, count, inv_mass, inv_inertia_world, pos, quat, pos0, quat0, linvel, angvel)
         solve_contacts(rows, count, inv_mass, inv_inertia_world, pos, quat, pos0, quat0, linvel, angvel, inv_h,
                        push_max, True)  # fmt: skip
