@@ -22,26 +22,39 @@ prange = numba.prange
 _PACKAGE_DIR = Path(__file__).resolve().parent
 
 
+# Subpackages whose kernels nothing outside them calls: an edit there invalidates their own kernels only.
+# Everything else (top-level modules, geometry/, dynamics/) is the core that every kernel may embed.
+_LEAF_PACKAGES = ("articulation",)
+
+
+def _leaf_of(path: Path) -> str | None:
+    parts = path.relative_to(_PACKAGE_DIR).parts
+    return parts[0] if len(parts) > 1 and parts[0] in _LEAF_PACKAGES else None
+
+
 @functools.cache
-def _package_stamp() -> str:
-    """One stamp for every source file of the package (paths, sizes, modification times)."""
+def _package_stamp(leaf: str | None = None) -> str:
+    """One stamp for the core sources (paths, sizes, modification times), plus those of ``leaf`` if given."""
     digest = hashlib.sha256()
     for path in sorted(_PACKAGE_DIR.rglob("*.py")):
+        if _leaf_of(path) not in (None, leaf):
+            continue
         stat = path.stat()
         digest.update(f"{path.relative_to(_PACKAGE_DIR)}:{stat.st_size}:{stat.st_mtime_ns};".encode())
     return digest.hexdigest()
 
 
 class _PackageCacheLocator(caching.InTreeCacheLocator):
-    """Numba's on-disk cache beside the sources, invalidated when *any* tumble source changes.
+    """Numba's on-disk cache beside the sources, invalidated when any core tumble source changes.
 
     Numba stamps a cached kernel with its own file only, but a kernel embeds the code of the helpers it calls
     from other files: after an edit of ``contact_solver.py`` (or an upgrade of the package over an old cache)
-    ``substep.run_substeps`` would load with the old solver inside. One stamp for the whole package is safe.
+    ``substep.run_substeps`` would load with the old solver inside. One stamp for the whole core is safe; a
+    leaf subpackage (``_LEAF_PACKAGES``) adds its own files to the stamp of its kernels.
     """
 
     def get_source_stamp(self):
-        return _package_stamp()
+        return _package_stamp(_leaf_of(Path(self._py_file).resolve()))
 
     @classmethod
     def from_function(cls, py_func, py_file):
