@@ -14,23 +14,30 @@ __version__ = "0.1.0"
 
 from . import mass, rotation, shapes
 from .errors import SimulationError
-from .handles import Body
+from .handles import Body, Joint
+from .joints import BallJoint, DistanceJoint, FixedJoint, HingeJoint, SliderJoint
 from .mass import MassProperties
 from .shapes import Box, Capsule, ConvexHull, Cylinder, Plane, Shape, ShapeType, Sphere, TriMesh
 from .trajectory import Trajectory
 from .world import World
 
 __all__ = [
+    "BallJoint",
     "Body",
     "Box",
     "Capsule",
     "ConvexHull",
     "Cylinder",
+    "DistanceJoint",
+    "FixedJoint",
+    "HingeJoint",
+    "Joint",
     "MassProperties",
     "Plane",
     "Shape",
     "ShapeType",
     "SimulationError",
+    "SliderJoint",
     "Sphere",
     "Trajectory",
     "TriMesh",

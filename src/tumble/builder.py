@@ -10,12 +10,14 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .dynamics.joint_solver import JointArrays
+from .geometry.broad_phase import exclusion_table
 from .geometry.packing import pack_geometry
 from .mass import MassProperties
 from .model import Model
 from .shapes import Capsule, Cylinder, Sphere
 
-__all__ = ["ModelBuilder", "ShapeSpec"]
+__all__ = ["JointSpec", "ModelBuilder", "ShapeSpec"]
 
 
 @dataclass(frozen=True)
@@ -33,6 +35,22 @@ class ShapeSpec:
 
 
 @dataclass
+class JointSpec:
+    """One joint in body-frame terms (body -1: the world); ``drive`` is mutable (motor speed and the like)."""
+
+    kind: int
+    body_a: int
+    body_b: int
+    local_anchor_a: np.ndarray  # (3,) anchor minus a's COM, a's frame
+    local_anchor_b: np.ndarray  # (3,)
+    local_frame_a: np.ndarray  # (4,) joint frame (x: axis) in a's frame
+    local_frame_b: np.ndarray  # (4,)
+    drive: np.ndarray  # (7,) see joint_solver.JointArrays
+    collide_connected: bool
+    to_world: bool = False  # the user's ``b`` was None: the world is body_a (-1) and the user's ``a`` is body_b
+
+
+@dataclass
 class _BodyRow:
     mass_properties: MassProperties | None  # None: static
     shapes: list[ShapeSpec]
@@ -46,6 +64,7 @@ class ModelBuilder:
     """Accumulates bodies; :meth:`finalize` packs them into structure-of-arrays."""
 
     rows: list[_BodyRow] = field(default_factory=list)
+    joints: list[JointSpec] = field(default_factory=list)
 
     @property
     def body_count(self) -> int:
@@ -64,6 +83,27 @@ class ModelBuilder:
         self.rows.append(_BodyRow(mass_properties, list(shapes), linear_damping, angular_damping, name))
         return len(self.rows) - 1
 
+    def add_joint(self, spec: JointSpec) -> int:
+        self.joints.append(spec)
+        return len(self.joints) - 1
+
+    def _joint_arrays(self) -> tuple[JointArrays, np.ndarray]:
+        if not self.joints:
+            return JointArrays.empty(), np.zeros((0, 2), np.int64)
+        specs = self.joints
+        arrays = JointArrays(
+            np.array([s.kind for s in specs], np.int64),
+            np.array([s.body_a for s in specs], np.int64),
+            np.array([s.body_b for s in specs], np.int64),
+            np.array([s.local_anchor_a for s in specs], np.float64),
+            np.array([s.local_anchor_b for s in specs], np.float64),
+            np.array([s.local_frame_a for s in specs], np.float64),
+            np.array([s.local_frame_b for s in specs], np.float64),
+            np.array([s.drive for s in specs], np.float64),
+        )
+        pairs = [(s.body_a, s.body_b) for s in specs if not s.collide_connected and min(s.body_a, s.body_b) >= 0]
+        return arrays, exclusion_table(np.array(pairs, np.int64).reshape(-1, 2))
+
     def finalize(self, gravity: np.ndarray) -> Model:
         n = len(self.rows)
         mass = np.zeros(n)
@@ -78,6 +118,7 @@ class ModelBuilder:
         is_dynamic = mass > 0.0
         inv_mass = np.divide(1.0, mass, out=np.zeros(n), where=is_dynamic)
         specs = [(i, s) for i, row in enumerate(self.rows) for s in row.shapes]
+        joints, joint_exclusions = self._joint_arrays()
         return Model(
             gravity=np.array(gravity, dtype=np.float64),
             body_mass=mass,
@@ -103,6 +144,8 @@ class ModelBuilder:
             shape_mask=np.array([s.mask for _, s in specs], dtype=np.uint32),
             has_contacts=_contacts_possible(specs, is_dynamic),
             shapes=tuple(s.shape for _, s in specs),
+            joints=joints,
+            joint_exclusions=joint_exclusions,
         )
 
 

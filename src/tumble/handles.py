@@ -11,7 +11,7 @@ import numpy as np
 from ._validate import as_quaternion, as_vector3
 from .rotation import quat_rotate, quat_to_matrix
 
-__all__ = ["Body"]
+__all__ = ["Body", "Joint"]
 
 
 class Body:
@@ -211,3 +211,213 @@ class Body:
         kind = "static" if self.is_static else f"mass={self.mass:.6g}"
         label = f"{self.name!r}, " if self.name else ""
         return f"Body({label}#{self._index}, {kind}, position={np.round(self.position, 6).tolist()})"
+
+
+class Joint:
+    """A joint of a :class:`~tumble.World`: a ``(world, row)`` view, as :class:`Body` is.
+
+    Coordinates (``angle``, ``translation``, ``length``) are those of ``b`` relative to ``a``, or of ``a``
+    relative to the world when ``b`` is None. ``reaction_force`` and ``reaction_torque`` are what the joint
+    exerted on body ``a`` over the last step (its average: impulse / dt), in the world frame, the torque about the
+    anchor; body ``b`` (or the world) received the opposite. Both are zero before the first step.
+    """
+
+    __slots__ = ("_world", "_index")
+
+    def __init__(self, world, index: int):
+        self._world = world
+        self._index = index
+
+    @property
+    def index(self) -> int:
+        return self._index
+
+    def _spec(self):
+        return self._world._builder.joints[self._index]
+
+    @property
+    def kind(self) -> str:
+        """``"ball"``, ``"hinge"``, ``"slider"``, ``"fixed"`` or ``"distance"``."""
+        from .joints import JointKind
+
+        return JointKind(self._spec().kind).name.lower()
+
+    @property
+    def body_a(self) -> Body:
+        spec = self._spec()
+        return self._world.bodies[spec.body_b if spec.to_world else spec.body_a]
+
+    @property
+    def body_b(self) -> Body | None:
+        """The second body, or None when the joint holds ``a`` to the world."""
+        spec = self._spec()
+        return None if spec.to_world else self._world.bodies[spec.body_b]
+
+    def _anchor(self, body: int, local: np.ndarray) -> np.ndarray:
+        if body < 0:
+            return local.copy()
+        s = self._world.state
+        return s.body_pos[body] + quat_rotate(s.body_quat[body], local)
+
+    @property
+    def anchor_a(self) -> np.ndarray:
+        """(3,) the anchor carried by ``a``, world frame [m]."""
+        spec = self._spec()
+        if spec.to_world:
+            return self._anchor(spec.body_b, spec.local_anchor_b)
+        return self._anchor(spec.body_a, spec.local_anchor_a)
+
+    @property
+    def anchor_b(self) -> np.ndarray:
+        """(3,) the anchor carried by ``b`` (fixed in the world when ``b`` is None), world frame [m]."""
+        spec = self._spec()
+        if spec.to_world:
+            return self._anchor(spec.body_a, spec.local_anchor_a)
+        return self._anchor(spec.body_b, spec.local_anchor_b)
+
+    def _coordinates(self) -> np.ndarray:
+        from .dynamics.joint_solver import joint_coordinates
+
+        world = self._world
+        model, state = world.model, world.state
+        out = np.zeros((model.joint_count, 4))
+        joint_coordinates(model.joints, state.body_pos, state.body_quat, state.body_linvel,
+                          world.angular_velocities(), out)  # fmt: skip
+        return out[self._index]
+
+    def _require(self, *kinds: str) -> None:
+        if self.kind not in kinds:
+            raise AttributeError(f"a {self.kind} joint has no such coordinate (only {' and '.join(kinds)} joints)")
+
+    @property
+    def angle(self) -> float:
+        """Hinge: the angle of ``b`` relative to ``a`` about the axis [rad], zero at creation, in (−π, π]."""
+        self._require("hinge")
+        return float(self._coordinates()[0])
+
+    @property
+    def angular_speed(self) -> float:
+        """Hinge: d(angle)/dt [rad/s]."""
+        self._require("hinge")
+        return float(self._coordinates()[1])
+
+    @property
+    def translation(self) -> float:
+        """Slider: how far ``b``'s anchor has moved along the axis from ``a``'s [m], zero at creation."""
+        self._require("slider")
+        return float(self._coordinates()[0])
+
+    @property
+    def speed(self) -> float:
+        """Slider: d(translation)/dt [m/s]; distance joint: d(length)/dt."""
+        self._require("slider", "distance")
+        return float(self._coordinates()[1])
+
+    @property
+    def length(self) -> float:
+        """Distance joint: the distance between the anchors now [m]."""
+        self._require("distance")
+        return float(self._coordinates()[0])
+
+    @property
+    def position_error(self) -> float:
+        """How far the joint is from holding [m]: the gap between the anchors (ball, hinge, fixed), its part
+        across the axis (slider), or how far the length lies outside ``[min_length, max_length]`` (distance)."""
+        value, _, gap, _ = self._coordinates()
+        if self.kind == "slider":
+            return float(np.sqrt(max(gap**2 - value**2, 0.0)))
+        if self.kind == "distance":
+            lower, upper = self._spec().drive[:2]
+            return float(max(lower - value, value - upper, 0.0))
+        return float(gap)
+
+    @property
+    def angular_error(self) -> float:
+        """Misalignment [rad]: hinge axes apart, or the relative rotation of a fixed or slider joint; 0 else."""
+        return float(self._coordinates()[3])
+
+    @property
+    def reaction_force(self) -> np.ndarray:
+        """(3,) [N] the force the joint exerted on ``a`` over the last step (world frame)."""
+        scratch = self._world._scratch
+        if scratch.joint_step == 0.0 or self._index >= scratch.joint_force_total.shape[0]:
+            return np.zeros(3)
+        return self._on_a(scratch.joint_force_total[self._index]) / scratch.joint_step
+
+    @property
+    def reaction_torque(self) -> np.ndarray:
+        """(3,) [N m] the torque the joint exerted on ``a`` about the anchor over the last step (world frame)."""
+        scratch = self._world._scratch
+        if scratch.joint_step == 0.0 or self._index >= scratch.joint_moment_total.shape[0]:
+            return np.zeros(3)
+        return self._on_a(scratch.joint_moment_total[self._index]) / scratch.joint_step
+
+    def _on_a(self, received_by_b: np.ndarray) -> np.ndarray:
+        """The solver sums what its body b received: the user's ``a`` when joined to the world, else ``b``."""
+        return received_by_b.copy() if self._spec().to_world else -received_by_b
+
+    def _set_drive(self, column: int, name: str, value, kinds: tuple[str, ...], nonnegative: bool = False) -> None:
+        from ._validate import as_float
+
+        self._require(*kinds)
+        value = as_float(name, value, nonnegative=nonnegative)
+        self._spec().drive[column] = value
+        model = self._world._model
+        if model is not None:
+            model.joints.drive[self._index, column] = value
+        self._wake()
+
+    def _wake(self) -> None:
+        for body in (self.body_a, self.body_b):
+            if body is not None and not body.is_static:
+                body._require_dynamic("wake")
+
+    @property
+    def motor_speed(self) -> float:
+        """Hinge [rad/s] or slider [m/s]: the motor's target speed (settable)."""
+        return float(self._spec().drive[2])
+
+    @motor_speed.setter
+    def motor_speed(self, value) -> None:
+        self._set_drive(2, "motor_speed", value, ("hinge", "slider"))
+
+    @property
+    def max_motor_torque(self) -> float:
+        """Hinge: the motor's largest torque [N m] (settable; 0 turns the motor off)."""
+        self._require("hinge")
+        return float(self._spec().drive[3])
+
+    @max_motor_torque.setter
+    def max_motor_torque(self, value) -> None:
+        self._set_drive(3, "max_motor_torque", value, ("hinge",), nonnegative=True)
+
+    @property
+    def max_motor_force(self) -> float:
+        """Slider: the motor's largest force [N] (settable; 0 turns the motor off)."""
+        self._require("slider")
+        return float(self._spec().drive[3])
+
+    @max_motor_force.setter
+    def max_motor_force(self, value) -> None:
+        self._set_drive(3, "max_motor_force", value, ("slider",), nonnegative=True)
+
+    @property
+    def spring_target(self) -> float:
+        """Hinge [rad] or slider [m]: where the spring pulls (settable)."""
+        return float(self._spec().drive[6])
+
+    @spring_target.setter
+    def spring_target(self, value) -> None:
+        self._set_drive(6, "spring_target", value, ("hinge", "slider"))
+
+    def __eq__(self, other) -> bool:
+        return isinstance(other, Joint) and other._world is self._world and other._index == self._index
+
+    def __hash__(self) -> int:
+        return hash((id(self._world), self._index))
+
+    def __repr__(self) -> str:
+        b = self.body_b
+        label_a = self.body_a.name or self.body_a.index
+        label_b = "world" if b is None else (b.name or b.index)
+        return f"Joint(#{self._index}, {self.kind}, a={label_a!r}, b={label_b!r})"

@@ -6,12 +6,13 @@ Structure of arrays, prefix-named (``body_*``, ``shape_*``). Constant during a s
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import cached_property
 from typing import NamedTuple
 
 import numpy as np
 
+from .dynamics.joint_solver import JointArrays
 from .geometry.packing import GeometryArrays
 
 __all__ = ["Model", "BodyArrays"]
@@ -52,6 +53,8 @@ class Model:
         shape_group, shape_mask: (shape_count,) uint32 collision filter bits.
         has_contacts: whether two shapes of different bodies can touch (then the contact solver steps).
         shapes: the shape objects, in row order (for geometry that does not fit the arrays).
+        joints: the world joints (:class:`~tumble.dynamics.joint_solver.JointArrays`; body -1 is the world).
+        joint_exclusions: (k, 2) int64 sorted body pairs that a joint keeps from colliding.
     """
 
     gravity: np.ndarray
@@ -73,10 +76,16 @@ class Model:
     shape_mask: np.ndarray
     has_contacts: bool
     shapes: tuple
+    joints: JointArrays = field(default_factory=JointArrays.empty)
+    joint_exclusions: np.ndarray = field(default_factory=lambda: np.zeros((0, 2), np.int64))
 
     @property
     def body_count(self) -> int:
         return int(self.body_mass.shape[0])
+
+    @property
+    def joint_count(self) -> int:
+        return int(self.joints.kind.shape[0])
 
     @property
     def shape_count(self) -> int:
@@ -118,4 +127,4 @@ class Model:
     @property
     def has_constraints(self) -> bool:
         """Whether anything couples bodies (contacts or joints); free-motion integrators apply if not."""
-        return self.has_contacts
+        return self.has_contacts or self.joint_count > 0

@@ -46,6 +46,8 @@ DEFAULT_SOLVER = SolverSettings(
     sleep_linear=0.05,
     sleep_angular=0.05,
     time_to_sleep=0.5,
+    joint_hertz=120.0,
+    joint_damping_ratio=2.0,
 )
 
 

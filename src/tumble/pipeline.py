@@ -13,7 +13,8 @@ Bodies with contacts (the soft step of DESIGN.md):
     match_warm_start      state.contact_*        -> scratch.warm_*         (geometry/narrow_phase.py)
     wake_touched          manifolds              -> state.body_sleeping    (dynamics/islands.py)
     prepare_contacts      manifolds, bodies      -> scratch.rows           (dynamics/contact_solver.py)
-    run_substeps          integrate v, ball impacts, warm start, solve, integrate x, relax (dynamics/substep.py)
+    run_substeps          integrate v, ball impacts, warm start, solve, integrate x, relax: joints
+                          (dynamics/joint_solver.py), then contacts (dynamics/contact_solver.py)
     apply_restitution     rows                   -> velocities             (dynamics/contact_solver.py)
     limit_to_impact       pairs, poses           -> poses of fast bodies   (geometry/toi.py)
     store impulses        rows                   -> state.contact_*        (here)
@@ -140,6 +141,7 @@ def contact_step(model: Model, state: State, inputs: Inputs, params: Params, scr
         model.body_is_dynamic,
         shape_group=model.shape_group,
         shape_mask=model.shape_mask,
+        excluded_body_pairs=model.joint_exclusions,
         margin=settings.speculative_distance,
         buffer=scratch.pairs,
     )
@@ -177,6 +179,8 @@ def contact_step(model: Model, state: State, inputs: Inputs, params: Params, scr
             geom.shape_body,
             manifolds,
             count,
+            model.joints.body_a,
+            model.joints.body_b,
             state.body_sleep_time,
             state.body_sleeping,
             state.body_island,
@@ -207,6 +211,9 @@ def contact_step(model: Model, state: State, inputs: Inputs, params: Params, scr
         rows,
     )
     pos0, quat0 = state.body_pos.copy(), state.body_quat.copy()
+    scratch.joint_force_total[:] = 0.0
+    scratch.joint_moment_total[:] = 0.0
+    scratch.joint_step = dt
     run_substeps(
         bodies,
         moving,
@@ -227,6 +234,12 @@ def contact_step(model: Model, state: State, inputs: Inputs, params: Params, scr
         settings.substeps,
         settings.contact_push_max,
         settings.restitution_threshold,
+        model.joints,
+        state.joint_impulses,
+        settings.joint_hertz,
+        settings.joint_damping_ratio,
+        scratch.joint_force_total,
+        scratch.joint_moment_total,
     )
     apply_restitution(rows, count, inv_mass, inv_inertia_world, state.body_pos, state.body_quat, pos0, quat0,
                       state.body_linvel, angvel, settings.restitution_threshold)  # fmt: skip
@@ -241,6 +254,8 @@ def contact_step(model: Model, state: State, inputs: Inputs, params: Params, scr
             geom.shape_body,
             manifolds,
             count,
+            model.joints.body_a,
+            model.joints.body_b,
             state.body_linvel,
             angvel,
             dt,

@@ -29,6 +29,8 @@ class Scratch:
         contact_count: manifolds in use after the last contact step (``World.contacts`` reads them).
         aabb_lo, aabb_hi: (shape_count, 3) world bounds of the shapes; pairs: the broad phase's output buffer.
         island_parent, island_min_time: (body_count,) union-find work arrays of the sleep pass.
+        joint_force_total, joint_moment_total: (joint_count, 3) linear and angular impulses each joint gave its
+            body b over the last contact step [N s, N m s]; joint_step: that step's length [s] (0: none yet).
     """
 
     backup_pos: np.ndarray
@@ -49,9 +51,12 @@ class Scratch:
     pairs: PairBuffer = field(default_factory=PairBuffer)
     island_parent: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
     island_min_time: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    joint_force_total: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
+    joint_moment_total: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
+    joint_step: float = 0.0
 
     @classmethod
-    def for_world(cls, body_count: int, shape_count: int) -> Scratch:
+    def for_world(cls, body_count: int, shape_count: int, joint_count: int = 0) -> Scratch:
         scratch = cls(
             np.zeros((body_count, 3)), np.zeros((body_count, 4)), np.zeros((body_count, 3)),
             np.zeros((body_count, 3)), np.full(body_count, -1, dtype=np.int64), empty_recording(body_count),
@@ -60,6 +65,7 @@ class Scratch:
         scratch.aabb_lo, scratch.aabb_hi = np.zeros((shape_count, 3)), np.zeros((shape_count, 3))
         scratch.island_parent = np.zeros(body_count, np.int64)
         scratch.island_min_time = np.zeros(body_count)
+        scratch.joint_force_total, scratch.joint_moment_total = np.zeros((joint_count, 3)), np.zeros((joint_count, 3))
         return scratch
 
     @property

@@ -7,7 +7,8 @@ velocity, is the state (as in the course's state vector ``(x, A, p, L)``): with 
 constant. ``Body.angular_velocity`` computes ``ω = R I⁻¹ Rᵀ L``.
 
 The ``contact_*`` arrays are the impulses of the last step's contact points, kept to warm-start the next
-step; they are sorted by shape pair and change size every step.
+step; they are sorted by shape pair and change size every step. The ``joint_*`` arrays are the joints'
+accumulated impulses, one row per joint, kept for the same reason.
 """
 
 from __future__ import annotations
@@ -38,6 +39,11 @@ _CONTACT_FIELDS = (
     "contact_normal_impulse",
     "contact_tangent_impulse",
 )
+
+_JOINT_FIELDS = ("joint_linear_impulse", "joint_angular_impulse", "joint_drive_impulse")
+_JOINT_WIDTHS = (3, 3, 4)
+# Fields replaced (not written in place) when they change size: contacts every step, joints when added.
+_SIZED_FIELDS = _CONTACT_FIELDS + _JOINT_FIELDS
 
 
 def _no_contacts() -> dict[str, np.ndarray]:
@@ -87,6 +93,9 @@ class State:
     contact_feature: np.ndarray = field(default_factory=lambda: _no_contacts()["contact_feature"])
     contact_normal_impulse: np.ndarray = field(default_factory=lambda: _no_contacts()["contact_normal_impulse"])
     contact_tangent_impulse: np.ndarray = field(default_factory=lambda: _no_contacts()["contact_tangent_impulse"])
+    joint_linear_impulse: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
+    joint_angular_impulse: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
+    joint_drive_impulse: np.ndarray = field(default_factory=lambda: np.zeros((0, 4)))
 
     @classmethod
     def empty(cls, body_count: int = 0) -> State:
@@ -103,8 +112,20 @@ class State:
         new = State.empty(len(pos))
         new.body_pos[:], new.body_quat[:], new.body_linvel[:], new.body_angmom[:] = pos, quat, linvel, angmom
         arrays = {f: np.concatenate([getattr(self, f), getattr(new, f)]) for f in _BODY_FIELDS}
-        contacts = {f: getattr(self, f) for f in _CONTACT_FIELDS}  # shapes are only appended: rows stay valid
-        return State(**arrays, **contacts, time=self.time, step_count=self.step_count)
+        kept = {f: getattr(self, f) for f in _SIZED_FIELDS}  # shapes and joints are only appended: rows stay valid
+        return State(**arrays, **kept, time=self.time, step_count=self.step_count)
+
+    def with_joints(self, joint_count: int) -> None:
+        """Append zero impulses for joints added since (rows of existing joints are kept)."""
+        for name, width in zip(_JOINT_FIELDS, _JOINT_WIDTHS, strict=True):
+            old = getattr(self, name)
+            if old.shape[0] < joint_count:
+                setattr(self, name, np.concatenate([old, np.zeros((joint_count - old.shape[0], width))]))
+
+    @property
+    def joint_impulses(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(linear (J, 3), angular (J, 3), drive (J, 4))`` as the joint kernels take them."""
+        return self.joint_linear_impulse, self.joint_angular_impulse, self.joint_drive_impulse
 
     @property
     def body_count(self) -> int:
@@ -115,14 +136,14 @@ class State:
         return int(self.contact_shape_a.shape[0])
 
     def copy(self) -> State:
-        arrays = {f: getattr(self, f).copy() for f in _BODY_FIELDS + _CONTACT_FIELDS}
+        arrays = {f: getattr(self, f).copy() for f in _BODY_FIELDS + _SIZED_FIELDS}
         return State(**arrays, time=self.time, step_count=self.step_count)
 
     def assign(self, other: State) -> None:
         """Overwrite this state with ``other``: body arrays in place (views held by users stay valid)."""
         for f in _BODY_FIELDS:
             np.copyto(getattr(self, f), getattr(other, f))
-        for f in _CONTACT_FIELDS:
+        for f in _SIZED_FIELDS:
             setattr(self, f, getattr(other, f).copy())
         self.time = other.time
         self.step_count = other.step_count
@@ -135,7 +156,7 @@ class State:
     def digest(self) -> str:
         """sha256 over the arrays (fixed field order), the time and the step count."""
         h = hashlib.sha256()
-        for f in _BODY_FIELDS + _CONTACT_FIELDS:
+        for f in _BODY_FIELDS + _SIZED_FIELDS:
             array = getattr(self, f)
             h.update(str(array.shape).encode())
             h.update(np.ascontiguousarray(array).tobytes())

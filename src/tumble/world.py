@@ -16,7 +16,7 @@ from . import diagnostics
 from ._validate import as_float, as_quaternion, as_vector3, mass_or_density
 from .builder import ModelBuilder, ShapeSpec
 from .errors import SimulationError
-from .handles import Body
+from .handles import Body, Joint
 from .inputs import Inputs
 from .mass import MassProperties
 from .model import Model
@@ -156,6 +156,8 @@ class World:
         restitution_threshold: float = DEFAULT_SOLVER.restitution_threshold,
         speculative_distance: float = DEFAULT_SOLVER.speculative_distance,
         sleep: bool = DEFAULT_SOLVER.sleep,
+        joint_hertz: float = DEFAULT_SOLVER.joint_hertz,
+        joint_damping_ratio: float = DEFAULT_SOLVER.joint_damping_ratio,
     ):
         self._gravity = as_vector3("gravity", gravity)
         self._params = Params(integrator=_check_integrator(integrator))
@@ -167,6 +169,8 @@ class World:
             restitution_threshold=restitution_threshold,
             speculative_distance=speculative_distance,
             sleep=sleep,
+            joint_hertz=joint_hertz,
+            joint_damping_ratio=joint_damping_ratio,
         )
         self._builder = ModelBuilder()
         self._model: Model | None = None
@@ -175,6 +179,7 @@ class World:
         self._scratch = Scratch.for_world(0, 0)
         self._pending: list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = []
         self._bodies: list[Body] = []
+        self._joints: list[Joint] = []
 
     # --- building -----------------------------------------------------------------------------------
 
@@ -253,6 +258,29 @@ class World:
         index = self._builder.add_body(None, items, name=name)
         return self._append(index, position, quat, np.zeros(3), np.zeros(3))
 
+    def add_joint(self, joint) -> Joint:
+        """Join two bodies (or a body and the world) with a :class:`~tumble.BallJoint`, :class:`~tumble.HingeJoint`,
+        :class:`~tumble.SliderJoint`, :class:`~tumble.FixedJoint` or :class:`~tumble.DistanceJoint`.
+
+        The joint's anchors and axes are world-frame values taken at the bodies' current poses; the two bodies
+        stop colliding with each other unless ``collide_connected=True``. Returns a :class:`~tumble.handles.Joint`
+        handle (angles, reaction forces, motor settings); see ``docs/joints.md``.
+        """
+        from .joints import joint_spec
+
+        spec = joint_spec(joint, self)
+        index = self._builder.add_joint(spec)
+        self._model = None
+        handle = Joint(self, index)
+        self._joints.append(handle)
+        handle._wake()
+        return handle
+
+    @property
+    def joints(self) -> list[Joint]:
+        """Every joint, in the order they were added."""
+        return list(self._joints)
+
     @staticmethod
     def _check_material(friction, restitution, rolling_resistance) -> tuple[float, float, float]:
         friction = as_float("friction", friction, nonnegative=True)
@@ -285,7 +313,7 @@ class World:
         if self._model is not None:
             return
         self._model = self._builder.finalize(self._gravity)
-        self._scratch = Scratch.for_world(self._model.body_count, self._model.shape_count)
+        self._scratch = Scratch.for_world(self._model.body_count, self._model.shape_count, self._model.joint_count)
         if self._pending:
             self._state = self._state.grown(*(np.array(column) for column in zip(*self._pending, strict=True)))
             added = Inputs.zeros(len(self._pending))
@@ -294,6 +322,7 @@ class World:
                 np.concatenate([self._inputs.body_torque, added.body_torque]),
             )
             self._pending.clear()
+        self._state.with_joints(self._model.joint_count)
 
     # --- arrays -------------------------------------------------------------------------------------
 
@@ -345,7 +374,8 @@ class World:
         """Change contact solver settings by name: ``substeps`` (int >= 1), ``contact_hertz`` (> 0),
         ``contact_damping_ratio`` (>= 0), ``contact_push_max`` [m/s] (> 0), ``restitution_threshold`` [m/s] (>= 0),
         ``speculative_distance`` [m] (>= 0), ``sleep`` (bool), ``sleep_linear`` [m/s], ``sleep_angular`` [rad/s],
-        ``time_to_sleep`` [s] (all >= 0)."""
+        ``time_to_sleep`` [s] (all >= 0), ``joint_hertz`` (> 0) and ``joint_damping_ratio`` (>= 0), the stiffness of
+        the joints' position correction."""
         current = self._params.solver._asdict()
         for key, value in settings.items():
             if key not in current:
@@ -361,7 +391,7 @@ class World:
                     raise TypeError(f"sleep must be True or False, got {value!r}")
                 current[key] = bool(value)
             else:
-                positive = key in ("contact_hertz", "contact_push_max")
+                positive = key in ("contact_hertz", "contact_push_max", "joint_hertz")
                 current[key] = as_float(key, value, positive=positive, nonnegative=not positive)
         self._params.solver = SolverSettings(**current)
 

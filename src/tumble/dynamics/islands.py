@@ -1,7 +1,7 @@
 """Islands and sleeping: bodies at rest stop being simulated until something touches or pushes them.
 
-An island is a set of dynamic bodies linked by touching contacts (static bodies do not link: a floor does not
-join everything standing on it). Each body keeps a timer of how long its speeds have stayed below
+An island is a set of dynamic bodies linked by touching contacts or joints (static bodies do not link: a floor
+does not join everything standing on it). Each body keeps a timer of how long its speeds have stayed below
 ``sleep_linear`` and ``sleep_angular``; when every body of an island has been still for ``time_to_sleep``, the
 whole island sleeps: velocities zeroed, skipped by the integrator and the solver (Box2D's scheme, E. Catto,
 "Box2D v3 islands", 2023). A sleeping island wakes whole when an awake body touches it, or when a force,
@@ -38,10 +38,15 @@ def _union(parent, a, b):
 
 
 @kernel
-def _islands(is_dynamic, shape_body, manifold_a, manifold_b, point_count, separation, count, parent):
-    """Union the dynamic bodies of every touching manifold (a point with separation <= 0)."""
+def _islands(is_dynamic, shape_body, manifold_a, manifold_b, point_count, separation, count, joint_a, joint_b,
+             parent):  # fmt: skip
+    """Union the dynamic bodies of every touching manifold (a point with separation <= 0) and of every joint."""
     for i in range(parent.shape[0]):
         parent[i] = i
+    for j in range(joint_a.shape[0]):
+        a, b = joint_a[j], joint_b[j]
+        if a >= 0 and b >= 0 and is_dynamic[a] and is_dynamic[b]:
+            _union(parent, a, b)
     for m in range(count):
         a, b = shape_body[manifold_a[m]], shape_body[manifold_b[m]]
         if not (is_dynamic[a] and is_dynamic[b]):
@@ -56,8 +61,8 @@ def _islands(is_dynamic, shape_body, manifold_a, manifold_b, point_count, separa
 
 @kernel
 def update_sleep(
-    is_dynamic, shape_body, manifolds, count, linvel, angvel, dt, sleep_linear, sleep_angular, time_to_sleep,
-    sleep_time, sleeping, island, parent, island_min_time,
+    is_dynamic, shape_body, manifolds, count, joint_a, joint_b, linvel, angvel, dt, sleep_linear, sleep_angular,
+    time_to_sleep, sleep_time, sleeping, island, parent, island_min_time,
 ):  # fmt: skip
     """Advance the sleep timers and put to sleep the islands whose bodies have all been still long enough.
 
@@ -75,7 +80,7 @@ def update_sleep(
         else:
             sleep_time[i] += dt
     _islands(is_dynamic, shape_body, manifolds.shape_a, manifolds.shape_b, manifolds.point_count,
-             manifolds.separation, count, parent)  # fmt: skip
+             manifolds.separation, count, joint_a, joint_b, parent)  # fmt: skip
     for i in range(n):
         island_min_time[i] = math.inf
     for i in range(n):
@@ -91,9 +96,20 @@ def update_sleep(
                 angvel[i, k] = 0.0
 
 
+@inline
+def _wake_island(sleeping, sleep_time, island, root):
+    woken = 0
+    for i in range(sleeping.shape[0]):
+        if sleeping[i] and island[i] == root:
+            sleeping[i] = False
+            sleep_time[i] = 0.0
+            woken += 1
+    return woken
+
+
 @kernel
-def wake_touched(is_dynamic, shape_body, manifolds, count, sleep_time, sleeping, island):
-    """Wake every sleeping island that an awake dynamic body touches (or nearly touches) this step.
+def wake_touched(is_dynamic, shape_body, manifolds, count, joint_a, joint_b, sleep_time, sleeping, island):
+    """Wake every sleeping island that an awake dynamic body touches (or nearly touches) or is jointed to.
 
     Returns the number of bodies woken. Writes: sleeping, sleep_time.
     """
@@ -102,10 +118,12 @@ def wake_touched(is_dynamic, shape_body, manifolds, count, sleep_time, sleeping,
         a, b = shape_body[manifolds.shape_a[m]], shape_body[manifolds.shape_b[m]]
         for sleeper, other in ((a, b), (b, a)):
             if sleeping[sleeper] and is_dynamic[other] and not sleeping[other]:
-                root = island[sleeper]
-                for i in range(sleeping.shape[0]):
-                    if sleeping[i] and island[i] == root:
-                        sleeping[i] = False
-                        sleep_time[i] = 0.0
-                        woken += 1
+                woken += _wake_island(sleeping, sleep_time, island, island[sleeper])
+    for j in range(joint_a.shape[0]):
+        a, b = joint_a[j], joint_b[j]
+        if a < 0 or b < 0:
+            continue
+        for sleeper, other in ((a, b), (b, a)):
+            if sleeping[sleeper] and is_dynamic[other] and not sleeping[other]:
+                woken += _wake_island(sleeping, sleep_time, island, island[sleeper])
     return woken

@@ -8,6 +8,8 @@ state is ω (world frame), which the contact impulses change directly; the step 
 
 from __future__ import annotations
 
+import os
+
 from .._jit import kernel
 from ..math3d import (
     add_scaled,
@@ -24,7 +26,9 @@ from ..math3d import (
 )
 from .contact_solver import accumulate_impulses, resolve_impacts, solve_contacts, warm_start_contacts
 from .free_motion import implicit_spin
+from .joint_solver import solve_joints, warm_start_joints
 
+PROJECT = int(os.environ.get("PROJECT", "1"))
 __all__ = ["run_substeps", "to_angular_velocity", "to_angular_momentum"]
 
 
@@ -82,20 +86,27 @@ def integrate_positions(moving, linvel, angvel, pos, quat, h):
 @kernel
 def run_substeps(
     bodies, moving, inv_mass, gravity, force, torque, rows, count, inv_inertia_world, pos, quat, pos0, quat0, linvel,
-    angvel, h, substeps, push_max, threshold,
+    angvel, h, substeps, push_max, threshold, joints, joint_impulses, joint_hertz, joint_damping_ratio,
+    joint_force_total, joint_moment_total,
 ):  # fmt: skip
     """The soft step's inner loop (Catto 2024): per substep integrate velocities, bounce the ball impacts of the
-    substep, warm start, solve with a soft bias, integrate positions, relax without bias. ``inv_mass`` and
-    ``inv_inertia_world`` are zero for bodies
-    that do not move (static or sleeping), which the solver then treats as fixed."""
+    substep, warm start (joints, then contacts), solve with a soft bias, integrate positions, relax without bias.
+    ``inv_mass`` and ``inv_inertia_world`` are zero for bodies that do not move (static or sleeping), which the
+    solver then treats as fixed."""
     inv_h = 1.0 / h
     for _ in range(substeps):
         integrate_velocities(bodies, moving, gravity, force, torque, quat, linvel, angvel, h)
         resolve_impacts(rows, count, inv_mass, inv_inertia_world, pos, quat, pos0, quat0, linvel, angvel, h, threshold)
+        warm_start_joints(joints, joint_impulses, inv_mass, inv_inertia_world, pos, quat, linvel, angvel,
+                          joint_force_total, joint_moment_total)  # fmt: skip
         warm_start_contacts(rows, count, inv_mass, inv_inertia_world, pos, quat, pos0, quat0, linvel, angvel)
+        solve_joints(joints, joint_impulses, inv_mass, inv_inertia_world, pos, quat, linvel, angvel, h, joint_hertz,
+                     joint_damping_ratio, True, joint_force_total, joint_moment_total)  # fmt: skip
         solve_contacts(rows, count, inv_mass, inv_inertia_world, pos, quat, pos0, quat0, linvel, angvel, inv_h,
                        push_max, True)  # fmt: skip
         integrate_positions(moving, linvel, angvel, pos, quat, h)
+        solve_joints(joints, joint_impulses, inv_mass, inv_inertia_world, pos, quat, linvel, angvel, h, joint_hertz,
+                     joint_damping_ratio, False, joint_force_total, joint_moment_total)  # fmt: skip
         solve_contacts(rows, count, inv_mass, inv_inertia_world, pos, quat, pos0, quat0, linvel, angvel, inv_h,
                        push_max, False)  # fmt: skip
         accumulate_impulses(rows, count)
