@@ -15,8 +15,19 @@ PINNED = {
     "basic/hello_world.py": r"final: t=1\.00 s, z=1\.0950 m, energy drift \de-(09|1\d)",
     # 5 s of the T-handle at 12 rad/s: the first flip is at 2.16 s; energy and |L| conserved (first version).
     "basic/dzhanibekov.py": r"final: 1 flips in 5\.0 s, energy drift \d\.\de-1\d, \|L\| drift \d\.\de-1[4-6]",
+    # Lagrange's equations through SymPy (first versions): exact elliptic period, virtual work, chaos with E kept.
+    "lagrange/pendulum.py": r"final: period 2\.367842 s \(exact 2\.367842 s, error \de-1\d\), "
+    r"energy drift \de-(09|1\d)",
+    "lagrange/slider_crank.py": r"final: 12 crank angles balanced, max torque error \de-1\d N m",
+    "lagrange/double_pendulum.py": r"final: 5\.0 s of chaotic swinging, energy drift \de-(09|1\d)",
 }
-STEPS = {"basic/hello_world.py": 100, "basic/dzhanibekov.py": 5000}
+STEPS = {
+    "basic/hello_world.py": 100,
+    "basic/dzhanibekov.py": 5000,
+    "lagrange/pendulum.py": 400,
+    "lagrange/slider_crank.py": 12,
+    "lagrange/double_pendulum.py": 500,
+}
 
 
 def load(relative: str):
