@@ -32,12 +32,23 @@ def _leaf_of(path: Path) -> str | None:
     return parts[0] if len(parts) > 1 and parts[0] in _LEAF_PACKAGES else None
 
 
+# Modules without compiled code whose constants kernels freeze at compile time (shape and integrator codes).
+_CONSTANT_MODULES = ("shapes.py", "params.py", "geometry/manifold.py", "geometry/packing.py")
+
+
+def _compiles(path: Path) -> bool:
+    """Whether a module's code or constants can end up inside a kernel: it defines compiled code, or it is one of
+    :data:`_CONSTANT_MODULES`. The facade, scenes and handles never do, so editing them keeps the cache."""
+    relative = path.relative_to(_PACKAGE_DIR).as_posix()
+    return relative in _CONSTANT_MODULES or "_jit import" in path.read_text(encoding="utf-8")
+
+
 @functools.cache
 def _package_stamp(leaf: str | None = None) -> str:
-    """One stamp for the core sources (paths, sizes, modification times), plus those of ``leaf`` if given."""
+    """One stamp for the core's compiled sources (paths, sizes, modification times), plus those of ``leaf``."""
     digest = hashlib.sha256()
     for path in sorted(_PACKAGE_DIR.rglob("*.py")):
-        if _leaf_of(path) not in (None, leaf):
+        if _leaf_of(path) not in (None, leaf) or not _compiles(path):
             continue
         stat = path.stat()
         digest.update(f"{path.relative_to(_PACKAGE_DIR)}:{stat.st_size}:{stat.st_mtime_ns};".encode())
