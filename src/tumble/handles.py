@@ -280,7 +280,7 @@ class Joint:
 
         world = self._world
         model, state = world.model, world.state
-        out = np.zeros((model.joint_count, 4))
+        out = np.zeros((model.joint_count, 5))
         joint_coordinates(model.joints, state.body_pos, state.body_quat, state.body_linvel,
                           world.angular_velocities(), out)  # fmt: skip
         return out[self._index]
@@ -300,6 +300,18 @@ class Joint:
         """Hinge: d(angle)/dt [rad/s]."""
         self._require("hinge")
         return float(self._coordinates()[1])
+
+    @property
+    def twist(self) -> float:
+        """Ball joint: the twist of ``b`` relative to ``a`` about the joint's axis [rad], in (−π, π]."""
+        self._require("ball")
+        return float(self._coordinates()[0])
+
+    @property
+    def swing(self) -> float:
+        """Ball joint: the angle between the two bodies' joint axes [rad] (bounded by ``cone_angle``)."""
+        self._require("ball")
+        return float(self._coordinates()[4])
 
     @property
     def translation(self) -> float:
@@ -323,7 +335,7 @@ class Joint:
     def position_error(self) -> float:
         """How far the joint is from holding [m]: the gap between the anchors (ball, hinge, fixed), its part
         across the axis (slider), or how far the length lies outside ``[min_length, max_length]`` (distance)."""
-        value, _, gap, _ = self._coordinates()
+        value, _, gap, _, _ = self._coordinates()
         if self.kind == "slider":
             return float(np.sqrt(max(gap**2 - value**2, 0.0)))
         if self.kind == "distance":

@@ -79,6 +79,7 @@ class _Drive:
     spring_hertz: float
     spring_damping_ratio: float
     spring_target: float
+    cone: float = math.inf  # ball joints: the largest swing [rad]
 
     @classmethod
     def checked(cls, lower, upper, motor_speed, max_motor_name, max_motor, spring_hertz, spring_damping_ratio,
@@ -123,17 +124,38 @@ class _JointBase:
 class BallJoint(_JointBase):
     """Keeps one point of ``a`` and one of ``b`` together (3 rotational freedoms): a shoulder, a chain link.
 
+    Optional limits, about a twist ``axis`` (world frame at creation; a ragdoll's limb direction): a swing cone
+    (the axis carried by ``b`` stays within ``cone_angle`` of the one carried by ``a``) and twist limits
+    ``twist_lower``/``twist_upper`` about it.
+
     Args:
         a, b: bodies (``b=None``: the world).
         anchor: (3,) the common point [m], world frame, at creation.
+        axis: (3,) the twist axis, needed with any limit. cone_angle: [rad] in (0, π]. twist_lower, twist_upper:
+            [rad] in [−π, π] (``None``: free on that side).
     """
 
     kind = JointKind.BALL
 
-    def __init__(self, a, b, anchor, *, collide_connected: bool = False):
+    def __init__(self, a, b, anchor, *, axis=None, cone_angle=None, twist_lower=None, twist_upper=None,
+                 collide_connected: bool = False):  # fmt: skip
         self._set_bodies(a, b, collide_connected)
         self._set("anchor", as_vector3("anchor", anchor))
-        self._set("drive", _NO_DRIVE)
+        limited = cone_angle is not None or twist_lower is not None or twist_upper is not None
+        if limited and axis is None:
+            raise ValueError(
+                "axis must be given with cone_angle, twist_lower or twist_upper (the axis they are measured about)"
+            )
+        if axis is not None:
+            self._set("axis", _unit_axis(axis))
+        cone = math.inf if cone_angle is None else as_float("cone_angle", cone_angle, positive=True)
+        if cone != math.inf and cone > math.pi:
+            raise ValueError(f"cone_angle must be in (0, π], got {cone!r}")
+        lo, hi = _bounds("twist_lower", twist_lower, "twist_upper", twist_upper)
+        for name, value in (("twist_lower", lo), ("twist_upper", hi)):
+            if math.isfinite(value) and abs(value) > math.pi:
+                raise ValueError(f"{name} must be in [-π, π], got {value!r}")
+        self._set("drive", _Drive(lo, hi, 0.0, 0.0, 0.0, 0.0, 0.0, cone))
 
 
 class HingeJoint(_JointBase):
@@ -319,7 +341,16 @@ def joint_spec(joint, world) -> JointSpec:
         local_frame_a=quat_multiply(quat_conjugate(qa), frame),
         local_frame_b=quat_multiply(quat_conjugate(qb), frame),
         drive=np.array(
-            [d.lower, d.upper, d.motor_speed, d.max_motor, d.spring_hertz, d.spring_damping_ratio, d.spring_target],
+            [
+                d.lower,
+                d.upper,
+                d.motor_speed,
+                d.max_motor,
+                d.spring_hertz,
+                d.spring_damping_ratio,
+                d.spring_target,
+                d.cone,
+            ],
             np.float64,
         ),  # fmt: skip
         collide_connected=joint.collide_connected,

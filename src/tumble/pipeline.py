@@ -84,8 +84,8 @@ def _contact_steps(model, state, inputs, params, scratch, h, n_steps, recording,
     """Soft steps one after the other; on a non-finite value, restore the state before that step."""
     if params.resolve_integrator(True) != Integrator.SYMPLECTIC:
         raise ValueError(
-            f"integrator={params.integrator!r} integrates free bodies only; a world whose shapes can touch steps "
-            "with the contact solver: use integrator='auto' or 'symplectic'"
+            f"integrator={params.integrator!r} integrates free bodies only; a world whose shapes can touch or whose "
+            "bodies are jointed steps with the contact and joint solver: use integrator='auto' or 'symplectic'"
         )
     zero = Inputs.zeros(model.body_count)
     for step in range(n_steps):

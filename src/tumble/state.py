@@ -41,7 +41,7 @@ _CONTACT_FIELDS = (
 )
 
 _JOINT_FIELDS = ("joint_linear_impulse", "joint_angular_impulse", "joint_drive_impulse")
-_JOINT_WIDTHS = (3, 3, 4)
+_JOINT_WIDTHS = (3, 3, 5)
 # Fields replaced (not written in place) when they change size: contacts every step, joints when added.
 _SIZED_FIELDS = _CONTACT_FIELDS + _JOINT_FIELDS
 
@@ -95,7 +95,7 @@ class State:
     contact_tangent_impulse: np.ndarray = field(default_factory=lambda: _no_contacts()["contact_tangent_impulse"])
     joint_linear_impulse: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
     joint_angular_impulse: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
-    joint_drive_impulse: np.ndarray = field(default_factory=lambda: np.zeros((0, 4)))
+    joint_drive_impulse: np.ndarray = field(default_factory=lambda: np.zeros((0, 5)))
 
     @classmethod
     def empty(cls, body_count: int = 0) -> State:
@@ -124,7 +124,7 @@ class State:
 
     @property
     def joint_impulses(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """``(linear (J, 3), angular (J, 3), drive (J, 4))`` as the joint kernels take them."""
+        """``(linear (J, 3), angular (J, 3), drive (J, 5))`` as the joint kernels take them."""
         return self.joint_linear_impulse, self.joint_angular_impulse, self.joint_drive_impulse
 
     @property

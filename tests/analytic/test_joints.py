@@ -111,9 +111,7 @@ def test_slider_spring_oscillates_at_its_frequency_and_limits_hold():
 def test_hinge_motor_spins_a_door_up_to_speed_with_bounded_torque():
     world = tumble.World(gravity=(0, 0, 0))
     door = world.add_body(tumble.Box((1.0, 0.05, 2.0)), mass=10.0, position=(0.5, 0.0, 1.0))
-    hinge = world.add_joint(
-        tumble.HingeJoint(door, None, (0, 0, 1), (0, 0, 1), motor_speed=1.0, max_motor_torque=5.0)
-    )
+    hinge = world.add_joint(tumble.HingeJoint(door, None, (0, 0, 1), (0, 0, 1), motor_speed=1.0, max_motor_torque=5.0))
     inertia_about_hinge = 10.0 * (1.0**2 + 0.05**2) / 12 + 10.0 * 0.5**2
     world.step(DT)
     # torque-limited: ω after one step = τ dt / I
@@ -289,3 +287,33 @@ def test_a_jointed_island_sleeps_together_and_wakes_when_pushed():
     assert not a.sleeping and not b.sleeping
     world.step(DT)
     assert abs(a.velocity[0]) > 0.0
+
+
+def test_ball_joint_cone_and_twist_limits_hold():
+    # A rod held at one end, starting horizontal along the cone's axis: it swings down until the 30° cone stops it.
+    world = tumble.World()
+    rod = world.add_body(
+        tumble.Box((0.05, 0.05, 1.0)), mass=1.0, position=(0.5, 0, 0),
+        orientation=tumble.rotation.quat_from_axis_angle((0, 1, 0), math.pi / 2),
+    )  # fmt: skip
+    shoulder = world.add_joint(tumble.BallJoint(rod, None, (0, 0, 0), axis=(1, 0, 0), cone_angle=math.radians(30)))
+    swings = []
+    for _ in range(120):
+        world.step(DT)
+        swings.append(shoulder.swing)
+    assert max(swings) < math.radians(30) + 1e-3
+    assert swings[-1] == pytest.approx(math.radians(30), abs=2e-3)  # resting against the cone
+    assert shoulder.position_error < 1e-3
+    # Spun about its own axis, a rod turns until the twist limit (about -z here: the spin is negative).
+    world = tumble.World(gravity=(0, 0, 0))
+    rod = world.add_body(tumble.Box((0.05, 0.05, 1.0)), mass=1.0, position=(0, 0, -0.5), angular_velocity=(0, 0, 3))
+    wrist = world.add_joint(
+        tumble.BallJoint(rod, None, (0, 0, 0), axis=(0, 0, -1), twist_lower=-0.5, twist_upper=0.5, cone_angle=0.3)
+    )
+    twists = []
+    for _ in range(120):
+        world.step(DT)
+        twists.append(wrist.twist)
+    assert min(twists) > -0.5 - 1e-3
+    assert twists[-1] == pytest.approx(-0.5, abs=2e-3)
+    assert wrist.swing < 1e-6

@@ -86,3 +86,16 @@ def test_solver_joint_settings_are_checked():
         tumble.World(joint_hertz=0.0)
     with pytest.raises(ValueError, match="joint_damping_ratio"):
         tumble.World(joint_damping_ratio=-1.0)
+
+
+def test_ball_joint_limits_need_an_axis_and_sane_angles(world):
+    a = world.body("a")
+    with pytest.raises(ValueError, match="axis must be given with cone_angle"):
+        tumble.BallJoint(a, None, (0, 0, 0), cone_angle=0.5)
+    with pytest.raises(ValueError, match=r"cone_angle must be in \(0, π\], got 4.0"):
+        tumble.BallJoint(a, None, (0, 0, 0), axis=(0, 0, 1), cone_angle=4.0)
+    with pytest.raises(ValueError, match=r"twist_upper must be in \[-π, π\], got 5.0"):
+        tumble.BallJoint(a, None, (0, 0, 0), axis=(0, 0, 1), twist_upper=5.0)
+    joint = world.add_joint(tumble.HingeJoint(a, None, (0, 0, 0), (0, 0, 1)))
+    with pytest.raises(AttributeError, match="a hinge joint has no such coordinate"):
+        _ = joint.swing

@@ -61,9 +61,9 @@ __all__ = ["JointArrays", "joint_coordinates", "solve_joints", "warm_start_joint
 # Joint kinds (tumble.joints.JointKind)
 BALL, HINGE, SLIDER, FIXED, DISTANCE = 0, 1, 2, 3, 4
 # Columns of JointArrays.drive
-LOWER, UPPER, MOTOR_SPEED, MAX_MOTOR, SPRING_HERTZ, SPRING_RATIO, TARGET = 0, 1, 2, 3, 4, 5, 6
+LOWER, UPPER, MOTOR_SPEED, MAX_MOTOR, SPRING_HERTZ, SPRING_RATIO, TARGET, CONE = 0, 1, 2, 3, 4, 5, 6, 7
 # Columns of the drive impulses (state.joint_drive_impulse)
-SPRING, MOTOR, LOWER_LIMIT, UPPER_LIMIT = 0, 1, 2, 3
+SPRING, MOTOR, LOWER_LIMIT, UPPER_LIMIT, CONE_LIMIT = 0, 1, 2, 3, 4
 
 _EX, _EY, _EZ = (1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0)
 
@@ -78,13 +78,13 @@ class JointArrays(NamedTuple):
     local_anchor_b: np.ndarray  # (J, 3)
     local_frame_a: np.ndarray  # (J, 4) joint frame (x: the axis) relative to a's frame
     local_frame_b: np.ndarray  # (J, 4)
-    drive: np.ndarray  # (J, 7) lower, upper, motor speed, max motor torque/force, spring hertz, ratio, target
+    drive: np.ndarray  # (J, 8) lower, upper, motor speed, max motor torque/force, spring hertz, ratio, target, cone
 
     @classmethod
     def empty(cls) -> JointArrays:
         z = np.zeros
         return cls(z(0, np.int64), z(0, np.int64), z(0, np.int64), z((0, 3)), z((0, 3)), z((0, 4)), z((0, 4)),
-                   z((0, 7)))  # fmt: skip
+                   z((0, 8)))  # fmt: skip
 
 
 _ZERO33 = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
@@ -310,6 +310,44 @@ def _block_impulse(rows, linear_rows, lam, dir_l, dir_a, dir_b):
     return p, m, turn_a, turn_b
 
 
+@inline
+def _held_direction(dl, da, db, rows, linear_rows, ma, ia, mb, ib, dir_l, dir_a, dir_b, k_block, solvable, k_bd, y):
+    """A drive row ``(l, α, β)`` with the joint's rigid block held: minus the block's response ``y = K⁻¹ K_B,d``
+    (a Schur complement). Returns the held row, the block's share of a unit impulse (linear, angular) and the
+    row's effective mass ``1 / (K_dd − K_dB y)``."""
+    for r in range(rows):
+        k_bd[r] = (
+            (ma + mb) * dot(load3(dir_l, r), dl)
+            + dot(mat_vec(ia, load3(dir_a, r)), da)
+            + dot(mat_vec(ib, load3(dir_b, r)), db)
+        )
+        y[r] = k_bd[r]
+    if solvable:
+        _cholesky_solve(k_block, y, rows)
+    k_dd = (ma + mb) * dot(dl, dl) + dot(da, mat_vec(ia, da)) + dot(db, mat_vec(ib, db))
+    block_p, block_m = (0.0, 0.0, 0.0), (0.0, 0.0, 0.0)
+    for r in range(rows if solvable else 0):
+        k_dd -= y[r] * k_bd[r]
+        dl = add_scaled(dl, load3(dir_l, r), -y[r])
+        da = add_scaled(da, load3(dir_a, r), -y[r])
+        db = add_scaled(db, load3(dir_b, r), -y[r])
+        if r < linear_rows:
+            block_p = add_scaled(block_p, load3(dir_l, r), -y[r])
+        else:
+            block_m = add_scaled(block_m, load3(dir_a, r), -y[r])
+    return dl, da, db, block_p, block_m, (1.0 / k_dd if k_dd > 1e-12 else 0.0)
+
+
+@inline
+def _swing(fa, fb):
+    """The swing of ``b``'s joint x axis away from ``a``'s: its angle and the unit axis it turns about."""
+    na, nb = quat_rotate(fa, _EX), quat_rotate(fb, _EX)
+    turn = cross(na, nb)
+    sine = math.sqrt(dot(turn, turn))
+    axis = scale(turn, 1.0 / sine) if sine > 1e-9 else _EY
+    return math.atan2(sine, dot(na, nb)), axis
+
+
 @kernel
 def warm_start_joints(joints, impulses, inv_mass, inv_inertia_world, pos, quat, linvel, angvel, force_total,
                       moment_total):  # fmt: skip
@@ -335,8 +373,14 @@ def warm_start_joints(joints, impulses, inv_mass, inv_inertia_world, pos, quat, 
                  - drive_impulse[j, UPPER_LIMIT])  # fmt: skip
         if total != 0.0:
             n, _ = _drive_axis(kind, fa, d)
-            va, wa, vb, wb, dp, dm = _axial_apply(kind == HINGE, n, arm, rb, total, ma, ia, mb, ib, va, wa, vb, wb)
+            angular = kind == HINGE or kind == BALL
+            va, wa, vb, wb, dp, dm = _axial_apply(angular, n, arm, rb, total, ma, ia, mb, ib, va, wa, vb, wb)
             got_p, got_m = add(got_p, dp), add(got_m, dm)
+        if drive_impulse[j, CONE_LIMIT] != 0.0:
+            _, k = _swing(fa, fb)
+            m = scale(k, -drive_impulse[j, CONE_LIMIT])
+            wa, wb = sub(wa, mat_vec(ia, m)), add(wb, mat_vec(ib, m))
+            got_m = add(got_m, m)
         _store_body(a, linvel, angvel, va, wa)
         _store_body(b, linvel, angvel, vb, wb)
         store3(force_total, j, add(load3(force_total, j), got_p))
@@ -371,35 +415,18 @@ def solve_joints(joints, impulses, inv_mass, inv_inertia_world, pos, quat, linve
         # Drive along the free axis: spring, motor, limits (rod: a rigid distance), each row acting on the joint
         # *with its block held*: the row's direction minus its block response y = K⁻¹ K_B,d (a Schur complement),
         # so that a hinge limit stops a pendulum bob swinging round the pivot, not just its spin about its COM.
-        if kind == HINGE or kind == SLIDER or kind == DISTANCE:
+        if kind != FIXED:
+            angular = kind == HINGE or kind == BALL  # a ball joint's drive is its twist (limits only)
             n, value = _drive_axis(kind, fa, d)
-            if kind == HINGE:
+            if angular:
                 value = _hinge_angle(fa, fb)
                 dl, da, db = (0.0, 0.0, 0.0), n, n
             else:
                 dl, da, db = n, cross(arm, n), cross(rb, n)
-            for r in range(rows):
-                rhs[r] = (
-                    (ma + mb) * dot(load3(dir_l, r), dl)
-                    + dot(mat_vec(ia, load3(dir_a, r)), da)
-                    + dot(mat_vec(ib, load3(dir_b, r)), db)
-                )  # fmt: skip  (K_B,d; rhs is free until the block)
-                coupling[r] = rhs[r]
-            if solvable:
-                _cholesky_solve(k_block, coupling, rows)
-            k_dd = (ma + mb) * dot(dl, dl) + dot(da, mat_vec(ia, da)) + dot(db, mat_vec(ib, db))
-            block_p, block_m = (0.0, 0.0, 0.0), (0.0, 0.0, 0.0)  # the block's share of a unit drive impulse
-            for r in range(rows if solvable else 0):
-                k_dd -= coupling[r] * rhs[r]
-                dl = add_scaled(dl, load3(dir_l, r), -coupling[r])
-                da = add_scaled(da, load3(dir_a, r), -coupling[r])
-                db = add_scaled(db, load3(dir_b, r), -coupling[r])
-                if r < linear_rows:
-                    block_p = add_scaled(block_p, load3(dir_l, r), -coupling[r])
-                else:
-                    block_m = add_scaled(block_m, load3(dir_a, r), -coupling[r])
-            mass = 1.0 / k_dd if k_dd > 1e-12 else 0.0
-            pure_m = add(n, block_m) if kind == HINGE else block_m
+            dl, da, db, block_p, block_m, mass = _held_direction(
+                dl, da, db, rows, linear_rows, ma, ia, mb, ib, dir_l, dir_a, dir_b, k_block, solvable, rhs, coupling
+            )
+            pure_m = add(n, block_m) if angular else block_m
             lower, upper = joints.drive[j, LOWER], joints.drive[j, UPPER]
             spring_hertz = joints.drive[j, SPRING_HERTZ]
             rigid_rod = kind == DISTANCE and spring_hertz == 0.0 and lower == upper
@@ -444,6 +471,23 @@ def solve_joints(joints, impulses, inv_mass, inv_inertia_world, pos, quat, linve
                 store3(linear, j, add_scaled(load3(linear, j), block_p, step))
                 store3(angular_impulse, j, add_scaled(load3(angular_impulse, j), block_m, step))
                 got_p, got_m = add_scaled(got_p, dl, step), add_scaled(got_m, pure_m, step)
+            if kind == BALL and joints.drive[j, CONE] < math.pi:
+                # Swing cone: b's x axis within ``cone`` of a's, a one-sided limit about the axis it swings on.
+                swing, k = _swing(fa, fb)
+                dl, da, db, block_p, block_m, mass = _held_direction(
+                    (0.0, 0.0, 0.0), k, k, rows, linear_rows, ma, ia, mb, ib, dir_l, dir_a, dir_b, k_block, solvable,
+                    rhs, coupling,
+                )  # fmt: skip
+                old = drive_impulse[j, CONE_LIMIT]
+                rate = dot(dl, sub(vb, va)) - dot(da, wa) + dot(db, wb)
+                new = _limit_impulse(old, mass, -rate, joints.drive[j, CONE] - swing, inv_h, soft, use_bias)
+                step = old - new
+                drive_impulse[j, CONE_LIMIT] = new
+                va, vb = add_scaled(va, dl, -ma * step), add_scaled(vb, dl, mb * step)
+                wa, wb = sub(wa, mat_vec(ia, scale(da, step))), add(wb, mat_vec(ib, scale(db, step)))
+                store3(linear, j, add_scaled(load3(linear, j), block_p, step))
+                store3(angular_impulse, j, add_scaled(load3(angular_impulse, j), block_m, step))
+                got_p, got_m = add_scaled(got_p, dl, step), add_scaled(got_m, add(k, block_m), step)
         if rows > 0 and solvable:
             bias_rate, m_scale, i_scale = (soft[0], soft[1], soft[2]) if use_bias else (0.0, 1.0, 0.0)
             old_p, old_m = load3(linear, j), load3(angular_impulse, j)
@@ -469,8 +513,8 @@ def solve_joints(joints, impulses, inv_mass, inv_inertia_world, pos, quat, linve
 
 @kernel
 def joint_coordinates(joints, pos, quat, linvel, angvel, out):
-    """Per joint: the drive coordinate (hinge angle, slider translation, distance), its rate, the anchor gap
-    ``|d|`` and the axis misalignment angle [rad]. Writes: out (J, 4)."""
+    """Per joint: the drive coordinate (hinge angle or ball twist, slider translation, distance), its rate, the
+    anchor gap ``|d|``, the axis misalignment angle [rad] and a ball joint's swing [rad]. Writes: out (J, 5)."""
     for j in range(joints.kind.shape[0]):
         a, b, kind = joints.body_a[j], joints.body_b[j], joints.kind[j]
         xa, qa, va, wa = _load_pose(a, pos, quat, linvel, angvel)
@@ -478,10 +522,11 @@ def joint_coordinates(joints, pos, quat, linvel, angvel, out):
         ra, rb, d, fa, fb = _frames(joints, j, xa, qa, xb, qb)
         n, value = _drive_axis(kind, fa, d)
         arm = _arm_a(kind, ra, d)
-        if kind == HINGE:
+        if kind == HINGE or kind == BALL:
             value = _hinge_angle(fa, fb)
         out[j, 0] = value
-        out[j, 1] = _axial_rate(kind == HINGE, n, arm, rb, va, wa, vb, wb)
+        out[j, 1] = _axial_rate(kind == HINGE or kind == BALL, n, arm, rb, va, wa, vb, wb)
+        out[j, 4] = _swing(fa, fb)[0] if kind == BALL else 0.0
         out[j, 2] = math.sqrt(dot(d, d))
         if kind == HINGE:
             na, nb = quat_rotate(fa, _EX), quat_rotate(fb, _EX)
