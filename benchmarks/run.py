@@ -12,6 +12,8 @@ Run from the repository root:
 ``pile``, ``pyramid``, ``cubes``, ``big_pyramid``
                  contact scenes, tumble against MuJoCo and PyBullet (``benchmarks/contact.py``); ``big_pyramid``
                  (5050 boxes, tumble only) runs only when asked for with ``--only``.
+``world_chain``  a 20-link chain of world hinge joints released horizontal, 10 s: steps/s, joint gaps and energy,
+                 tumble against PyBullet and MuJoCo (``benchmarks/joints.py``).
 
 Every timing is the best of ``--repeat`` runs after a first call that is reported apart (it includes the
 JIT compile or the load from Numba's disk cache). Both engines run in the same process, so compare the
@@ -41,7 +43,7 @@ import numpy as np
 
 import tumble
 
-from . import contact, peers
+from . import contact, joints, peers
 
 __all__ = [
     "BENCHMARKS",
@@ -88,13 +90,16 @@ class Sizes:
     cubes_seconds: float = 3.0
     big_pyramid_base: int = 100
     big_pyramid_seconds: float = 2.0
+    chain_links: int = 20  # world-joint chain (benchmarks/joints.py)
+    chain_seconds: float = 10.0
 
 
 FULL = Sizes()
 QUICK = Sizes(
     tumbling_steps=200, record_every=100, bodies=64, body_steps=50, mujoco_seconds=0.02, repeat=1,
     cold_start=False, cold_start_bodies=8, pile_boxes=27, pile_seconds=0.2, pyramid_base=4, pyramid_seconds=0.2,
-    cubes_boxes=(8, 27), cubes_seconds=0.2, big_pyramid_base=6, big_pyramid_seconds=0.2,
+    cubes_boxes=(8, 27), cubes_seconds=0.2, big_pyramid_base=6, big_pyramid_seconds=0.2, chain_links=4,
+    chain_seconds=0.2,
 )  # fmt: skip
 
 
@@ -641,6 +646,7 @@ BENCHMARKS: dict[str, Callable[[Sizes], list[dict]]] = {
     "pyramid": contact.bench_pyramid,
     "cubes": contact.bench_cubes,
     "big_pyramid": contact.bench_big_pyramid,
+    "world_chain": joints.bench_world_chain,
 }
 OPTIONAL = ("big_pyramid",)  # slow: run only when asked for with --only
 

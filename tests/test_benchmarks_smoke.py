@@ -15,7 +15,7 @@ REPO = Path(__file__).resolve().parent.parent
 if str(REPO) not in sys.path:
     sys.path.insert(0, str(REPO))
 
-from benchmarks import peers, run  # noqa: E402
+from benchmarks import joints, peers, run  # noqa: E402
 
 TINY = run.Sizes(
     tumbling_steps=40, record_every=10, bodies=8, body_steps=5, mujoco_seconds=0.002, repeat=1,
@@ -164,3 +164,51 @@ def test_box_corners_and_mujoco_penetration_helpers():
     low = peers.box_vertices_min_z([[0.0, 0.0, 0.1], [0.0, 0.0, 0.1]], quat, [0.1, 0.1, 0.1])
     np.testing.assert_allclose(low, [0.0, 0.1 - 0.1 * np.sqrt(2.0)], atol=1e-12)
     assert "type='plane'" in peers.boxes_on_plane_mjcf([[0.0, 0.0, 0.1]], [[1.0, 0.0, 0.0, 0.0]], 0.1, 1.0)
+
+
+# --- world-joint chain (benchmarks/joints.py) -------------------------------------------------------------
+
+CHAIN_TINY = run.Sizes(repeat=1, chain_links=3, chain_seconds=0.05)
+
+
+def test_world_chain_rows():
+    """Runs with or without the peers; tumble's rows are there either way, each peer's when installed."""
+    rows = run.BENCHMARKS["world_chain"](CHAIN_TINY)
+    _assert_finite_numbers(rows)
+    assert {r["hz"] for r in rows if r["engine"] == "tumble"} == {60, 240}
+    engines = {r["engine"] for r in rows}
+    assert ("PyBullet" in engines) == peers.have_pybullet()
+    assert ("MuJoCo" in engines) == peers.have_mujoco()
+    for r in rows:
+        assert r["links"] == 3 and r["steps_per_s"] > 0 and r["notes"] == "", r
+        assert r["max_gap_mm"] < 5 and abs(r["energy_change"]) < 0.1
+        if r["engine"] == "MuJoCo" or "multibody" in r["config"]:  # generalised coordinates: exact joints
+            assert r["max_gap_mm"] < 1e-6 and r["max_axis_rad"] < 1e-9
+    if peers.have_pybullet():
+        reference = [r for r in rows if r["engine"] == "PyBullet" and r["hz"] == 240 and "maximal" in r["config"]]
+        assert [r["x_pybullet"] for r in reference] == [1.0]
+
+
+def test_world_chain_measures_agree_with_tumble_joint_handles():
+    """The benchmark's gap and axis angle (from body poses, the same for every engine) are tumble's own errors."""
+    world = joints.world_chain(4)
+    chain = joints.chain_from_world(world, 4)
+    assert chain.potential_drop == pytest.approx(0.1 * 9.81 * (0.05 + 0.15 + 0.25 + 0.35))
+    for _ in range(20):
+        world.step(1 / 60)
+    s = world.state
+    omega = world.angular_velocities()
+    frame = joints._Frame(s.body_pos.copy(), tumble.rotation.quat_to_matrix(s.body_quat), s.body_linvel.copy(), omega)
+    gap, angle = joints.joint_errors(chain, frame)
+    np.testing.assert_allclose(gap, [j.position_error for j in world.joints], rtol=1e-9, atol=1e-15)
+    np.testing.assert_allclose(angle, [j.angular_error for j in world.joints], atol=1e-9)
+    # tumble's potential energy is zero at the origin, the benchmark's at the pivot.
+    offset = chain.mass.sum() * (chain.gravity @ chain.pivot)
+    assert joints.energy(chain, frame) == pytest.approx(world.total_energy() + offset, rel=1e-12, abs=1e-12)
+
+
+def test_world_chain_is_the_pendulum_chain_scene_without_collisions():
+    chain = joints.world_chain(5)
+    assert [b.name for b in chain.bodies] == [f"link{k}" for k in range(5)]
+    assert len(chain.joints) == 5 and all(j.kind == "hinge" for j in chain.joints)
+    assert not chain.model.shape_mask.any()  # the benchmark's links collide with nothing

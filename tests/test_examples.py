@@ -20,6 +20,14 @@ PINNED = {
     r"energy drift \de-(09|1\d)",
     "lagrange/slider_crank.py": r"final: 12 crank angles balanced, max torque error \de-1\d N m",
     "lagrange/double_pendulum.py": r"final: 5\.0 s of chaotic swinging, energy drift \de-(09|1\d)",
+    # World joints (issue 4, first versions): a motor door sweeps a box to its 110° stop; a slider–crank loop on
+    # its closed form; a ragdoll falls down eight steps (chaotic: only the start, the time and the outcome pinned).
+    "joints/door.py": r"final: door at 110\.0° \(stop 110°\), 1\.000 rad/s before the box, box pushed 1\.\d\d m, "
+    r"hinge gap 0\.\d\d mm",
+    "joints/slider_crank.py": r"final: 2\.00 turns at 6\.28\d rad/s, piston within 0\.\d\d mm of "
+    r"r cos θ \+ √\(l² − r² sin² θ\)",
+    "joints/ragdoll.py": r"final: pelvis from 2\.61 m to 0\.[0-4]\d m in 3\.0 s, no body centre under a tread, "
+    r"joint gaps \d\.\d mm now",
 }
 STEPS = {
     "basic/hello_world.py": 100,
@@ -27,6 +35,9 @@ STEPS = {
     "lagrange/pendulum.py": 400,
     "lagrange/slider_crank.py": 12,
     "lagrange/double_pendulum.py": 500,
+    "joints/door.py": 150,
+    "joints/slider_crank.py": 120,
+    "joints/ragdoll.py": 180,
 }
 
 

@@ -124,6 +124,15 @@ class Model:
             self.body_angular_damping,
         )
 
+    @cached_property
+    def body_free_to_sweep(self) -> np.ndarray:
+        """(body_count,) bool: dynamic bodies that no joint holds, which time of impact may move back on its own
+        (moving one jointed body back would tear its joints open)."""
+        free = self.body_is_dynamic.copy()
+        for column in (self.joints.body_a, self.joints.body_b):
+            free[column[column >= 0]] = False
+        return free
+
     @property
     def has_constraints(self) -> bool:
         """Whether anything couples bodies (contacts or joints); free-motion integrators apply if not."""

@@ -243,8 +243,9 @@ def contact_step(model: Model, state: State, inputs: Inputs, params: Params, scr
     )
     apply_restitution(rows, count, inv_mass, inv_inertia_world, state.body_pos, state.body_quat, pos0, quat0,
                       state.body_linvel, angvel, settings.restitution_threshold)  # fmt: skip
-    # Fast bodies that would have passed into static geometry stop at their first touch.
-    limit_to_impact(geom, model.body_is_dynamic, pairs_a, pairs_b, pos0, quat0, state.body_pos, state.body_quat)
+    # Fast bodies that would have passed into static geometry stop at their first touch (unless jointed).
+    limit_to_impact(geom, model.body_is_dynamic, pairs_a, pairs_b, pos0, quat0, state.body_pos, state.body_quat,
+                    model.body_free_to_sweep)  # fmt: skip
     _store_impulses(state, manifolds, rows, count)
     scratch.contact_count = count
     # Islands whose bodies have all been still long enough go to sleep.

@@ -38,10 +38,11 @@ _MAX_ITERATIONS = 32
 _PLANE, _TRIMESH = int(ShapeType.PLANE), int(ShapeType.TRIMESH)
 
 
-def limit_to_impact(geom, body_is_dynamic, pairs_a, pairs_b, pos0, quat0, pos, quat) -> int:
+def limit_to_impact(geom, body_is_dynamic, pairs_a, pairs_b, pos0, quat0, pos, quat, body_may_move=None) -> int:
     """Move fast bodies back to their first touch with static geometry this step; returns how many moved.
 
-    Reads: the broad phase's pairs, body poses at the start of the step (``pos0``, ``quat0``) and now.
+    Reads: the broad phase's pairs, body poses at the start of the step (``pos0``, ``quat0``) and now, and
+    ``body_may_move`` (default: every dynamic body), the bodies that may be moved back on their own.
     Writes: ``pos``, ``quat`` of the bodies that would have passed into a static shape.
     """
     if pairs_a.shape[0] == 0:
@@ -57,6 +58,8 @@ def limit_to_impact(geom, body_is_dynamic, pairs_a, pairs_b, pos0, quat0, pos, q
     if moving.size == 0:
         return 0
     fast = _fast_bodies(geom, pos0, quat0, pos, quat)
+    if body_may_move is not None:
+        fast &= body_may_move
     keep = fast[geom.shape_body[moving]]
     if not keep.any():
         return 0
