@@ -3,6 +3,7 @@ PYTHON ?= python3.11
 VENV := .venv
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
+BROWSER_STAMP := $(VENV)/.browser
 
 .PHONY: install demo test test-nojit bench lint clean
 
@@ -17,7 +18,12 @@ install: $(STAMP)
 demo: $(STAMP)
 	$(PY) examples/basic/dzhanibekov.py
 
-test: $(STAMP)
+# The browser tests drive Debian's Chromium through Playwright (no browser download).
+$(BROWSER_STAMP): $(STAMP)
+	test -x /usr/bin/chromium || { apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium; }
+	touch $(BROWSER_STAMP)
+
+test: $(STAMP) $(BROWSER_STAMP)
 	$(PY) -m pytest -q
 	NUMBA_DISABLE_JIT=1 $(PY) -m pytest -q tests/unit -m "not slow" -p no:cacheprovider
 
