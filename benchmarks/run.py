@@ -12,6 +12,9 @@ Run from the repository root:
 ``pile``, ``pyramid``, ``cubes``, ``big_pyramid``
                  contact scenes, tumble against MuJoCo and PyBullet (``benchmarks/contact.py``); ``big_pyramid``
                  (5050 boxes, tumble only) runs only when asked for with ``--only``.
+``articulation_chain``
+                 the 20-link pendulum chain in generalised coordinates (``tumble.Articulation``, RK4 and symplectic)
+                 beside MuJoCo's Euler and RK4, 10 s at dt = 1 ms (``benchmarks/articulation.py``).
 ``world_chain``  a 20-link chain of world hinge joints released horizontal, 10 s: steps/s, joint gaps and energy,
                  tumble against PyBullet and MuJoCo (``benchmarks/joints.py``).
 
@@ -43,7 +46,7 @@ import numpy as np
 
 import tumble
 
-from . import contact, joints, peers
+from . import articulation, contact, joints, peers
 
 __all__ = [
     "BENCHMARKS",
@@ -647,6 +650,9 @@ BENCHMARKS: dict[str, Callable[[Sizes], list[dict]]] = {
     "cubes": contact.bench_cubes,
     "big_pyramid": contact.bench_big_pyramid,
     "world_chain": joints.bench_world_chain,
+    "articulation_chain": lambda sizes: articulation.bench_chain(
+        articulation.FULL if sizes.repeat > 1 else articulation.QUICK
+    ),
 }
 OPTIONAL = ("big_pyramid",)  # slow: run only when asked for with --only
 

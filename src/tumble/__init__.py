@@ -13,6 +13,7 @@ from __future__ import annotations
 __version__ = "0.1.0"
 
 from . import mass, rotation, shapes
+from .articulation import Articulation, Ball, Fixed, Free, Prismatic, Revolute
 from .errors import SimulationError
 from .handles import Body, Joint
 from .joints import BallJoint, DistanceJoint, FixedJoint, HingeJoint, SliderJoint
@@ -22,6 +23,8 @@ from .trajectory import Trajectory
 from .world import World
 
 __all__ = [
+    "Articulation",
+    "Ball",
     "BallJoint",
     "Body",
     "Box",
@@ -29,11 +32,15 @@ __all__ = [
     "ConvexHull",
     "Cylinder",
     "DistanceJoint",
+    "Fixed",
     "FixedJoint",
+    "Free",
     "HingeJoint",
     "Joint",
     "MassProperties",
     "Plane",
+    "Prismatic",
+    "Revolute",
     "Shape",
     "ShapeType",
     "SimulationError",

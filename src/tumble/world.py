@@ -125,6 +125,24 @@ def _body_mass_properties(items: list[ShapeSpec], mass, density, inertia) -> Mas
     return mp
 
 
+def _explicit_mass_properties(mass_properties, mass, density, inertia) -> MassProperties | None:
+    if mass_properties is None:
+        return None
+    if not isinstance(mass_properties, MassProperties):
+        raise TypeError(
+            f"mass_properties must be a tumble.MassProperties, got {mass_properties!r} "
+            f"({type(mass_properties).__name__})"
+        )
+    if mass is not None or density is not None or inertia is not None:
+        raise ValueError(
+            f"mass_properties= replaces mass=, density= and inertia=; got mass={mass!r}, density={density!r}, "
+            f"inertia={'given' if inertia is not None else None}"
+        )
+    if not mass_properties.mass > 0.0:
+        raise ValueError(f"mass_properties must have a positive mass for a dynamic body, got {mass_properties.mass!r}")
+    return mass_properties
+
+
 def _require_definite(mp: MassProperties) -> None:
     moments = np.linalg.eigvalsh(mp.inertia)
     if moments[0] <= 1e-12 * moments[-1]:
@@ -202,6 +220,7 @@ class World:
         collision_group: int = 1,
         collision_mask: int = 0xFFFFFFFF,
         name: str | None = None,
+        mass_properties: MassProperties | None = None,
     ) -> Body:
         """Add a dynamic body. ``velocity`` is that of the centre of mass.
 
@@ -211,7 +230,8 @@ class World:
         non-zero; ``collision_mask=0`` turns collisions off for this body. ``friction`` (Coulomb μ, mixed as
         ``√(μa μb)``), ``restitution`` (in [0, 1], mixed as the larger) and ``rolling_resistance`` (the coefficient
         ``c`` of a resisting torque ``c N r`` on round shapes of radius ``r``, mixed as the larger) apply to all
-        of the body's shapes; see ``docs/contact.md``.
+        of the body's shapes; see ``docs/contact.md``. ``mass_properties`` (a :class:`~tumble.MassProperties` in
+        the body frame) gives mass, centre of mass and inertia at once, in place of ``mass``/``density``/``inertia``.
         """
         position = as_vector3("position", position)
         quat = as_quaternion("orientation", orientation)
@@ -224,7 +244,9 @@ class World:
         group, mask = _check_filter("collision_group", collision_group), _check_filter("collision_mask", collision_mask)
         items = _shape_items(shape, material, group, mask)
         _check_dynamic_shapes(shape)
-        mp = _body_mass_properties(items, mass, density, inertia)
+        mp = _explicit_mass_properties(mass_properties, mass, density, inertia)
+        if mp is None:
+            mp = _body_mass_properties(items, mass, density, inertia)
         _require_definite(mp)
         com = position + quat_rotate(quat, mp.com)
         angmom = diagnostics.world_tensor_apply(mp.inertia[None], quat[None], angular_velocity[None])[0]
@@ -275,6 +297,15 @@ class World:
         self._joints.append(handle)
         handle._wake()
         return handle
+
+    def add_articulation(self, articulation):
+        """Copy a :class:`~tumble.articulation.Articulation` at its current ``q``, ``qd`` into this world: its links
+        become bodies that collide with the rest, its joints world joints (maximal coordinates, solved with the
+        contacts). Returns a :class:`~tumble.world_articulation.WorldArticulation` that reads ``q`` and ``qd``
+        back and applies joint forces; see ``docs/joints.md``."""
+        from .world_articulation import add_articulation
+
+        return add_articulation(self, articulation)
 
     @property
     def joints(self) -> list[Joint]:

@@ -1,0 +1,33 @@
+"""Articulations: trees of rigid links in generalised coordinates, with loop closures for closed chains.
+
+>>> from tumble.articulation import Articulation, Revolute
+>>> pendulum = Articulation(gravity=(0.0, 0.0, -9.81))
+>>> bob = pendulum.add_link(Revolute((0.0, 1.0, 0.0)), mass=1.0, shape_position=(1.0, 0.0, 0.0))
+>>> trajectory = pendulum.simulate(1.0, 1e-3)
+>>> trajectory.q.shape
+(1001, 1)
+
+Inverse dynamics by RNEA, the mass matrix by CRBA, forward dynamics by its sparse LTDL factorisation
+(Featherstone, *Rigid Body Dynamics Algorithms*, 2008, ch. 5-6), all in Numba kernels over flat arrays.
+``docs/articulation.md`` describes the coordinates, the algorithms and the limits.
+"""
+
+from __future__ import annotations
+
+from .articulation import Articulation, ArticulationTrajectory, Link
+from .joints import Ball, Fixed, Free, Joint, JointType, Prismatic, Revolute
+from .loops import LoopClosure
+
+__all__ = [
+    "Articulation",
+    "ArticulationTrajectory",
+    "Ball",
+    "Fixed",
+    "Free",
+    "Joint",
+    "JointType",
+    "Link",
+    "LoopClosure",
+    "Prismatic",
+    "Revolute",
+]

@@ -1,0 +1,237 @@
+"""The articulation as flat arrays: the model (what it *is*) and the work buffers of one evaluation.
+
+Everything lives in three contiguous buffers: ``ints`` (int64) and ``reals`` (float64) for the model, ``work``
+(float64) for what an evaluation computes. :func:`model_views` and :func:`work_views` carve them into a few
+wide 2-D arrays, one row per link (or degree of freedom, or loop closure) and named column offsets, as
+MuJoCo's ``jnt_*``/``body_*`` arrays. Few, wide arrays keep every call cheap: Numba unboxes each array
+argument of a kernel called from Python, and copies and reference-counts each array passed between compiled
+functions, so forty narrow arrays would cost more than a whole step of a small chain.
+
+Index conventions: links are numbered in the order they were added, so ``link_ints[i, PARENT] < i`` (``-1``
+is the base). Degrees of freedom (rows of ``qd``) are numbered the same way, and ``dof_ints[k, DOF_PARENT]
+< k`` is the previous degree of freedom on the path to the base (``-1`` at the base): the tree structure
+that the sparse factorisation of the mass matrix follows (Featherstone 2008, §6.5).
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+
+from .._jit import inline
+
+__all__ = ["Model", "Work", "counts", "model_views", "pack_model", "python_function", "work_size", "work_views"]
+
+# link_ints columns
+PARENT, JOINT, Q_START, V_START, DOF_TIP = 0, 1, 2, 3, 4
+LINK_INT_WIDTH = 5
+# link_reals columns: joint axis (link frame), origin pose in the parent frame, mass, centre of mass and
+# inertia about it (link frame, row-major 3x3)
+AXIS, ORIGIN_POS, ORIGIN_QUAT, MASS, COM, INERTIA = 0, 3, 6, 10, 11, 14
+LINK_REAL_WIDTH = 23
+# dof_ints columns
+DOF_PARENT, DOF_LINK = 0, 1
+# world entries
+GRAVITY, BASE_POS, BASE_QUAT = 0, 3, 6
+WORLD_WIDTH = 10
+# loop_ints / loop_reals columns
+LINK_A, LINK_B = 0, 1
+POINT_A, POINT_B = 0, 3
+
+# link_work columns: world pose, spatial velocity, velocity-product acceleration, spatial acceleration and
+# transmitted force (6 each), spatial inertia of the link and of its subtree (10 each); the articulated-body
+# inertia (21: a symmetric 6x6) and bias force (6) that children hand to the link in the ABA, and whether
+# they did (1.0) or not (0.0)
+POS, QUAT, VEL, VEL_PRODUCT, ACC, FORCE, INERTIA_WORLD, COMPOSITE = 0, 3, 7, 13, 19, 25, 31, 41
+ART_INERTIA, ART_BIAS, ART_STORED = 51, 72, 78
+LINK_WORK_WIDTH = 79
+# dof_work rows
+BIAS, RHS, QDD, DIAG, QD_START, QD_STAGE, QDD_SUM, QD_SUM, CHART = 0, 1, 2, 3, 4, 5, 6, 7, 8
+DOF_WORK_ROWS = 9
+# loop_work rows
+LOOP_RHS, LOOP_LAMBDA, LOOP_ACTIVE, LOOP_ERROR = 0, 1, 2, 3
+LOOP_WORK_ROWS = 4
+
+_HEADER = 4  # ints[0:4] = link_count, q_count, v_count, loop_count
+
+
+class Model(NamedTuple):
+    """What the articulation is. ``n`` links, ``nv`` degrees of freedom, ``L`` loop closures.
+
+    Attributes:
+        link_ints: (n, 5) int64: ``PARENT`` (-1: the base), ``JOINT`` (a
+            :class:`~tumble.articulation.joints.JointType`), ``Q_START``/``V_START`` (first row of the joint in
+            ``q``/``qd``), ``DOF_TIP`` (the last degree of freedom at or above the link; -1: none).
+        link_reals: (n, 23) float64: ``AXIS`` (3, unit, link frame), ``ORIGIN_POS`` (3) [m] and ``ORIGIN_QUAT``
+            (4): the link frame in the parent frame at zero displacement; ``MASS`` [kg]; ``COM`` (3) [m] and
+            ``INERTIA`` (9) [kg m²] about it, link frame.
+        dof_ints: (nv, 2) int64: ``DOF_PARENT`` (-1: none) and ``DOF_LINK``.
+        dof_damping: (nv,) joint damping [N m s/rad or N s/m].
+        world: (10,): ``GRAVITY`` (3) [m/s²], ``BASE_POS`` (3) [m], ``BASE_QUAT`` (4).
+        loop_ints: (L, 2) int64: ``LINK_A``, ``LINK_B`` (-1: the world).
+        loop_reals: (L, 6): ``POINT_A``, ``POINT_B`` [m], in the frames of link a and link b (or the world).
+    """
+
+    link_ints: np.ndarray
+    link_reals: np.ndarray
+    dof_ints: np.ndarray
+    dof_damping: np.ndarray
+    world: np.ndarray
+    loop_ints: np.ndarray
+    loop_reals: np.ndarray
+
+
+class Work(NamedTuple):
+    """What an evaluation computes; world frame throughout.
+
+    Spatial vectors are Featherstone's (2008, ch. 2): 6 numbers ``(angular, linear)`` taken at the world
+    origin. A spatial inertia is 10 numbers ``(m, m c, I_O)`` with ``I_O`` the rotational inertia about the
+    world origin stored as ``(xx, yy, zz, xy, xz, yz)``.
+
+    Attributes:
+        link_work: (n, 79): ``POS`` (3) [m], ``QUAT`` (4), ``VEL``, ``VEL_PRODUCT`` (the acceleration ``Ṡ q̇``
+            the joint adds), ``ACC``, ``FORCE`` (transmitted by the joint, RNEA) (6 each), ``INERTIA_WORLD``,
+            ``COMPOSITE`` (of the subtree, CRBA) (10 each), ``ART_INERTIA`` (21), ``ART_BIAS`` (6) and
+            ``ART_STORED`` (ABA).
+        dof_motion: (nv, 6): the motion subspace column of each degree of freedom.
+        dof_u: (nv, 6): the ABA's ``U = I^A S`` column of each degree of freedom.
+        mass_matrix: (nv, nv): the joint-space inertia matrix, or its LTDL factor after factorisation.
+        dof_work: (9, nv): rows ``BIAS``, ``RHS``, ``QDD``, ``DIAG`` (``H``'s diagonal, or the ABA's pivots) and
+            the integrator's ``QD_START``, ``QD_STAGE``, ``QDD_SUM``, ``QD_SUM``, ``CHART``.
+        q_start, q_stage: (nq,): the integrator's coordinates at the start of a step and at an RK4 stage.
+        loop_jac, loop_minv_jt: (3L, nv): the closure Jacobian ``J`` and ``(H⁻¹ Jᵀ)ᵀ``.
+        loop_matrix: (3L, 3L): ``J H⁻¹ Jᵀ`` or its factor.
+        loop_work: (4, 3L): rows ``LOOP_RHS`` (γ), ``LOOP_LAMBDA``, ``LOOP_ACTIVE``, ``LOOP_ERROR`` (φ).
+        energy: (2,) [J]: kinetic and potential.
+    """
+
+    link_work: np.ndarray
+    dof_motion: np.ndarray
+    dof_u: np.ndarray
+    mass_matrix: np.ndarray
+    dof_work: np.ndarray
+    q_start: np.ndarray
+    q_stage: np.ndarray
+    loop_jac: np.ndarray
+    loop_minv_jt: np.ndarray
+    loop_matrix: np.ndarray
+    loop_work: np.ndarray
+    energy: np.ndarray
+
+
+def _int_size(n: int, nv: int, loops: int) -> int:
+    return _HEADER + LINK_INT_WIDTH * n + 2 * nv + 2 * loops
+
+
+def _real_size(n: int, nv: int, loops: int) -> int:
+    return WORLD_WIDTH + LINK_REAL_WIDTH * n + nv + 6 * loops
+
+
+def work_size(n: int, nq: int, nv: int, loops: int) -> int:
+    """The length of the work buffer that :func:`work_views` carves."""
+    nc = 3 * loops
+    return LINK_WORK_WIDTH * n + 12 * nv + nv * nv + DOF_WORK_ROWS * nv + 2 * nq + 2 * nc * nv + nc * nc + 4 * nc + 2
+
+
+@inline
+def _rows(buffer, start, count, width):
+    """``buffer[start:start + count * width]`` seen as a (count, width) C-contiguous array, without a copy.
+
+    (``reshape`` is a runtime call in Numba, about 40 ns; ``as_strided`` is free but types the view as
+    non-contiguous, which makes the kernels 40 % slower.)
+    """
+    return buffer[start : start + count * width].reshape((count, width))
+
+
+@inline
+def model_views(ints, reals):
+    """Carve ``ints`` and ``reals`` into a :class:`Model` of views (no copies)."""
+    n, nv, nl = ints[0], ints[2], ints[3]
+    i = _HEADER
+    link_ints = _rows(ints, i, n, LINK_INT_WIDTH)
+    i += LINK_INT_WIDTH * n
+    dof_ints = _rows(ints, i, nv, 2)
+    loop_ints = _rows(ints, i + 2 * nv, nl, 2)
+    r = WORLD_WIDTH
+    link_reals = _rows(reals, r, n, LINK_REAL_WIDTH)
+    r += LINK_REAL_WIDTH * n
+    loop_reals = _rows(reals, r + nv, nl, 6)
+    return Model(link_ints, link_reals, dof_ints, reals[r : r + nv], reals[0:WORLD_WIDTH], loop_ints, loop_reals)
+
+
+@inline
+def work_views(work, n, nq, nv, nl):
+    """Carve ``work`` into a :class:`Work` of views."""
+    nc = 3 * nl
+    link_work = _rows(work, 0, n, LINK_WORK_WIDTH)
+    w = LINK_WORK_WIDTH * n
+    dof_motion = _rows(work, w, nv, 6)
+    dof_u = _rows(work, w + 6 * nv, nv, 6)
+    w += 12 * nv
+    mass_matrix = _rows(work, w, nv, nv)
+    w += nv * nv
+    dof_work = _rows(work, w, DOF_WORK_ROWS, nv)
+    w += DOF_WORK_ROWS * nv
+    q_start, q_stage = work[w : w + nq], work[w + nq : w + 2 * nq]
+    w += 2 * nq
+    loop_jac = _rows(work, w, nc, nv)
+    loop_minv_jt = _rows(work, w + nc * nv, nc, nv)
+    w += 2 * nc * nv
+    loop_matrix = _rows(work, w, nc, nc)
+    w += nc * nc
+    loop_work = _rows(work, w, LOOP_WORK_ROWS, nc)
+    w += LOOP_WORK_ROWS * nc
+    return Work(link_work, dof_motion, dof_u, mass_matrix, dof_work, q_start, q_stage, loop_jac, loop_minv_jt,
+                loop_matrix, loop_work, work[w : w + 2])  # fmt: skip
+
+
+def python_function(compiled):
+    """The plain Python function behind a compiled one (itself when ``NUMBA_DISABLE_JIT=1``)."""
+    return getattr(compiled, "py_func", compiled)
+
+
+def counts(ints: np.ndarray) -> tuple[int, int, int, int]:
+    """``(link_count, q_count, v_count, loop_count)`` from the header of ``ints``."""
+    return int(ints[0]), int(ints[1]), int(ints[2]), int(ints[3])
+
+
+def pack_model(links, loops, gravity, base_pos, base_quat) -> tuple[np.ndarray, np.ndarray]:
+    """Build ``(ints, reals)`` from link and loop descriptions.
+
+    Args:
+        links: sequence of :class:`~tumble.articulation.articulation.Link` (parents before children).
+        loops: sequence of :class:`~tumble.articulation.loops.LoopClosure`.
+        gravity, base_pos: (3,); base_quat: (4,), unit.
+    """
+    n, nl = len(links), len(loops)
+    nq = sum(link.joint.nq for link in links)
+    nv = sum(link.joint.nv for link in links)
+    ints = np.zeros(_int_size(n, nv, nl), dtype=np.int64)
+    reals = np.zeros(_real_size(n, nv, nl), dtype=np.float64)
+    ints[:_HEADER] = (n, nq, nv, nl)
+    m = python_function(model_views)(ints, reals)
+    m.world[GRAVITY : GRAVITY + 3], m.world[BASE_POS : BASE_POS + 3] = gravity, base_pos
+    m.world[BASE_QUAT : BASE_QUAT + 4] = base_quat
+    for i, link in enumerate(links):
+        joint = link.joint
+        above = -1 if link.parent is None else m.link_ints[link.parent, DOF_TIP]
+        for k in range(link.v_slice.start, link.v_slice.stop):
+            m.dof_ints[k] = (above, i)
+            m.dof_damping[k] = link.damping
+            above = k
+        m.link_ints[i] = (-1 if link.parent is None else link.parent, int(joint.type), link.q_slice.start,
+                          link.v_slice.start, above)  # fmt: skip
+        row = m.link_reals[i]
+        row[AXIS : AXIS + 3] = getattr(joint, "axis", (0.0, 0.0, 0.0))
+        row[ORIGIN_POS : ORIGIN_POS + 3] = link.position
+        row[ORIGIN_QUAT : ORIGIN_QUAT + 4] = link.orientation
+        if link.mass_properties is not None:
+            row[MASS] = link.mass_properties.mass
+            row[COM : COM + 3] = link.mass_properties.com
+            row[INERTIA : INERTIA + 9] = link.mass_properties.inertia.ravel()
+    for k, loop in enumerate(loops):
+        m.loop_ints[k] = (loop.link_a, -1 if loop.link_b is None else loop.link_b)
+        m.loop_reals[k, POINT_A : POINT_A + 3] = loop.point_a
+        m.loop_reals[k, POINT_B : POINT_B + 3] = loop.point_b
+    return ints, reals
