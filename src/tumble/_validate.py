@@ -71,6 +71,15 @@ def as_vector3(name: str, value) -> np.ndarray:
     return as_array(name, value, (3,), batch=False).copy()
 
 
+def as_unit_vector3(name: str, value, *, tiny: float = 1e-12) -> np.ndarray:
+    """One finite 3-vector longer than ``tiny``, returned normalised (an axis, a normal, a direction)."""
+    vector = as_vector3(name, value)
+    norm = float(np.linalg.norm(vector))
+    if not norm > tiny:
+        raise ValueError(f"{name} must be a non-zero vector, got {vector.tolist()}")
+    return vector / norm
+
+
 def as_quaternion(name: str, value) -> np.ndarray:
     """One finite, non-zero quaternion ``[w, x, y, z]``, returned normalised to unit length."""
     q = as_array(name, value, (4,), batch=False)

@@ -181,10 +181,17 @@ class Body:
         """Apply ``force`` [N] at world ``point`` (default the COM) during the next step only."""
         force = as_vector3("force", force)
         lever = self._lever(point)
+        with np.errstate(over="ignore", invalid="ignore"):
+            moment = np.cross(lever, force)
+        if not np.all(np.isfinite(moment)):
+            raise ValueError(
+                f"force {force.tolist()} at point {np.asarray(point).tolist()} has a moment about the centre of mass "
+                "that overflows (non-finite)"
+            )
         self._require_dynamic("apply_force")
         inputs = self._world.inputs
         inputs.body_force[self._index] += force
-        inputs.body_torque[self._index] += np.cross(lever, force)
+        inputs.body_torque[self._index] += moment
 
     def apply_torque(self, torque) -> None:
         """Apply ``torque`` [N m] (world frame) during the next step only."""

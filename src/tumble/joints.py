@@ -28,7 +28,7 @@ from enum import IntEnum
 
 import numpy as np
 
-from ._validate import as_float, as_vector3
+from ._validate import as_float, as_unit_vector3, as_vector3
 from .builder import JointSpec
 from .rotation import matrix_to_quat, quat_conjugate, quat_multiply, quat_rotate
 
@@ -50,14 +50,6 @@ class JointKind(IntEnum):
     SLIDER = 2
     FIXED = 3
     DISTANCE = 4
-
-
-def _unit_axis(value) -> np.ndarray:
-    axis = as_vector3("axis", value)
-    length = float(np.linalg.norm(axis))
-    if length < 1e-12:
-        raise ValueError(f"axis must be a non-zero vector, got {axis.tolist()}")
-    return axis / length
 
 
 def _bounds(name_lower: str, lower, name_upper: str, upper) -> tuple[float, float]:
@@ -147,7 +139,7 @@ class BallJoint(_JointBase):
                 "axis must be given with cone_angle, twist_lower or twist_upper (the axis they are measured about)"
             )
         if axis is not None:
-            self._set("axis", _unit_axis(axis))
+            self._set("axis", as_unit_vector3("axis", axis))
         cone = math.inf if cone_angle is None else as_float("cone_angle", cone_angle, positive=True)
         if cone != math.inf and cone > math.pi:
             raise ValueError(f"cone_angle must be in (0, π], got {cone!r}")
@@ -178,7 +170,7 @@ class HingeJoint(_JointBase):
                  spring_target: float = 0.0, collide_connected: bool = False):  # fmt: skip
         self._set_bodies(a, b, collide_connected)
         self._set("anchor", as_vector3("anchor", anchor))
-        self._set("axis", _unit_axis(axis))
+        self._set("axis", as_unit_vector3("axis", axis))
         self._set("drive", _Drive.checked(lower, upper, motor_speed, "max_motor_torque", max_motor_torque,
                                           spring_hertz, spring_damping_ratio, spring_target))  # fmt: skip
 
@@ -203,7 +195,7 @@ class SliderJoint(_JointBase):
                  spring_target: float = 0.0, collide_connected: bool = False):  # fmt: skip
         self._set_bodies(a, b, collide_connected)
         self._set("anchor", None if anchor is None else as_vector3("anchor", anchor))
-        self._set("axis", _unit_axis(axis))
+        self._set("axis", as_unit_vector3("axis", axis))
         self._set("drive", _Drive.checked(lower, upper, motor_speed, "max_motor_force", max_motor_force,
                                           spring_hertz, spring_damping_ratio, spring_target))  # fmt: skip
 

@@ -30,7 +30,7 @@ import numpy as np
 import scipy.spatial
 
 from . import mass as _mass
-from ._validate import _show, as_array, as_float, as_vector3
+from ._validate import _show, as_array, as_float, as_unit_vector3, as_vector3
 
 __all__ = [
     "ShapeType",
@@ -64,11 +64,7 @@ def _frozen(values) -> np.ndarray:
 
 
 def _unit_direction(direction) -> np.ndarray:
-    d = as_vector3("direction", direction)
-    norm = float(np.linalg.norm(d))
-    if not norm > 0.0:
-        raise ValueError(f"direction must be a non-zero vector, got {d.tolist()}")
-    return d / norm
+    return as_unit_vector3("direction", direction, tiny=0.0)
 
 
 class Shape:
@@ -314,12 +310,9 @@ class Plane(Shape):
     type = ShapeType.PLANE
 
     def __init__(self, normal=(0.0, 0.0, 1.0), offset=0.0) -> None:
-        n = as_vector3("normal", normal)
-        norm = float(np.linalg.norm(n))
-        if not norm > 0.0:
-            raise ValueError(f"normal must be a non-zero vector, got {n.tolist()}")
+        n = as_unit_vector3("normal", normal, tiny=0.0)
         c = as_float("offset", offset)
-        self._init((*(n / norm), c), volume=math.inf)
+        self._init((*n, c), volume=math.inf)
 
     @property
     def normal(self) -> np.ndarray:

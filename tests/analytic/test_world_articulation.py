@@ -17,7 +17,7 @@ Articulation, Ball, Fixed, Free, Prismatic, Revolute = (
 ROD = tumble.Box((0.05, 0.05, 1.0))
 
 
-def _double_pendulum(theta1=math.radians(30), theta2=math.radians(-50)):
+def _double_pendulum(theta1=0.5235987755982988, theta2=-0.8726646259971648):  # 30° and -50°
     art = Articulation(base_position=(0.0, 0.0, 3.0))
     upper = art.add_link(Revolute((0, 1, 0)), shape=ROD, mass=1.0, shape_position=(0, 0, -0.5), name="upper")
     art.add_link(Revolute((0, 1, 0)), parent=upper, position=(0, 0, -1.0), shape=ROD, mass=1.0,

@@ -38,7 +38,7 @@ def _unchanged(art, before):
 @pytest.mark.parametrize(
     ("axis", "error", "message"),
     [
-        ((0, 0, 0), ValueError, r"axis must be a non-zero 3-vector, got \[0.0, 0.0, 0.0\]"),
+        ((0, 0, 0), ValueError, r"axis must be a non-zero vector, got \[0.0, 0.0, 0.0\]"),
         ((1, math.nan, 0), ValueError, r"axis must be finite"),
         ((1, 0), ValueError, r"axis must have shape \(3\), got shape \(2,\)"),
         ("x", TypeError, r"axis must be an array"),

@@ -315,3 +315,11 @@ def test_a_refused_call_leaves_the_world_unchanged_and_steppable(call):
     world.add_body(tumble.Sphere(0.1), mass=1.0, position=(2.0, 0.0, 1.0))
     world.step(1 / 60)
     assert len(world.bodies) == 3 and np.all(np.isfinite(world.state.body_pos))
+
+
+def test_a_force_whose_moment_overflows_is_refused():
+    world = tumble.World()
+    body = world.add_body(tumble.Sphere(0.1), mass=1.0)
+    with pytest.raises(ValueError, match="has a moment about the centre of mass that overflows"):
+        body.apply_force((1e300, 0.0, 0.0), point=(0.0, 1e300, 0.0))
+    assert not world.inputs.body_torque.any()

@@ -24,7 +24,7 @@ from enum import IntEnum
 
 import numpy as np
 
-from .._validate import as_vector3
+from .._validate import as_unit_vector3
 
 __all__ = ["Ball", "Fixed", "Free", "Joint", "JointType", "Prismatic", "Revolute"]
 
@@ -40,11 +40,7 @@ class JointType(IntEnum):
 
 
 def _unit_axis(axis) -> np.ndarray:
-    vector = as_vector3("axis", axis)
-    norm = float(np.linalg.norm(vector))
-    if not norm > 1e-12:
-        raise ValueError(f"axis must be a non-zero 3-vector, got {vector.tolist()!r}")
-    unit = vector / norm
+    unit = as_unit_vector3("axis", axis)
     unit.flags.writeable = False
     return unit
 
