@@ -92,7 +92,7 @@ def _contact_steps(model, state, inputs, params, scratch, h, n_steps, recording,
         before = state.copy()
         loads = inputs if step == 0 else zero  # applied loads act during the first step only
         contact_step(model, state, loads, params, scratch, h)
-        bad = _first_non_finite_body(state)
+        bad = _first_non_finite_body(state, model.body_is_dynamic)
         if bad >= 0:
             state.assign(before)
             return step, bad
@@ -106,10 +106,13 @@ def _contact_steps(model, state, inputs, params, scratch, h, n_steps, recording,
     return n_steps, -1
 
 
-def _first_non_finite_body(state: State) -> int:
+def _first_non_finite_body(state: State, is_dynamic: np.ndarray) -> int:
+    """The first body with a non-finite value, dynamic bodies first (a static one only turns NaN through them)."""
     finite = np.isfinite(state.body_pos).all(axis=1) & np.isfinite(state.body_quat).all(axis=1)
     finite &= np.isfinite(state.body_linvel).all(axis=1) & np.isfinite(state.body_angmom).all(axis=1)
-    bad = np.flatnonzero(~finite)
+    bad = np.flatnonzero(~finite & is_dynamic)
+    if bad.size == 0:
+        bad = np.flatnonzero(~finite)
     return int(bad[0]) if bad.size else -1
 
 
@@ -283,3 +286,9 @@ def _store_impulses(state: State, manifolds, rows, count: int) -> None:
         rows.tangent_impulse[:count, :, 0, None] * rows.tangent1[:count, None, :]
         + rows.tangent_impulse[:count, :, 1, None] * rows.tangent2[:count, None, :]
     )
+    # Slots past each manifold's point count hold leftovers of earlier steps: zero them, so that the state (and
+    # its digest) holds only what the next step reads.
+    unused = np.arange(state.contact_feature.shape[1])[None, :] >= state.contact_point_count[:, None]
+    state.contact_feature[unused] = 0
+    state.contact_normal_impulse[unused] = 0.0
+    state.contact_tangent_impulse[unused] = 0.0

@@ -597,6 +597,22 @@ class World:
         indices = np.unique(model.shape_body[rows])
         return [self._bodies[int(i)] for i in indices]
 
+    # --- checkpoints --------------------------------------------------------------------------------
+
+    def save(self, path) -> None:
+        """Write a checkpoint (model description, settings, state; no pickle) that :meth:`load` resumes bit for
+        bit; see ``docs/files.md``."""
+        from .checkpoint import save_world
+
+        save_world(self, path)
+
+    @classmethod
+    def load(cls, path) -> World:
+        """The world saved by :meth:`save` to ``path``; stepping it continues the saved run bit for bit."""
+        from .checkpoint import load_world
+
+        return load_world(path, cls)
+
     def __repr__(self) -> str:
         dynamic = sum(1 for b in self._bodies if not b.is_static)
         return (
