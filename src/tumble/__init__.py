@@ -22,6 +22,13 @@ from .shapes import Box, Capsule, ConvexHull, Cylinder, Plane, Shape, ShapeType,
 from .trajectory import Trajectory
 from .world import World
 
+
+def load_scene(path) -> World:
+    """The world described by the scene file at ``path`` (TOML or JSON; see ``docs/scenes.md``)."""
+    from .scene_file import load
+
+    return load(path).world
+
 __all__ = [
     "Articulation",
     "Ball",
@@ -50,6 +57,7 @@ __all__ = [
     "TriMesh",
     "World",
     "__version__",
+    "load_scene",
     "mass",
     "rotation",
     "shapes",

@@ -16,6 +16,7 @@ from .shapes import Box, Capsule, ConvexHull, Cylinder, Plane, Sphere, TriMesh
 from .world import World
 
 __all__ = [
+    "files",
     "box_pile",
     "pyramid",
     "tower",
@@ -518,3 +519,11 @@ def ragdoll_stairs(steps: int = 8, rise: float = 0.2, run: float = 0.3, push: fl
             body.velocity = np.cross(spin, body.center_of_mass - at(0.0, 0.0, 0.0))
             body.angular_velocity = spin
     return world
+
+
+def files() -> list:
+    """The scene files shipped with tumble (``pathlib.Path``\\ s, sorted by name): load one with
+    ``tumble.load_scene(path)``; ``tumble examples`` lists and copies them."""
+    from .scene_file import shipped
+
+    return shipped()

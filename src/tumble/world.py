@@ -307,6 +307,13 @@ class World:
 
         return add_articulation(self, articulation)
 
+    def to_scene(self, *, dt: float | None = None, duration: float | None = None) -> dict:
+        """This world now as a scene dict, the structure of a scene file (``tumble.scene_file.dumps`` writes it as
+        TOML or JSON; ``tumble.scene_file.from_dict`` builds it again)."""
+        from .scene_file import to_scene
+
+        return to_scene(self, dt=dt, duration=duration)
+
     @property
     def joints(self) -> list[Joint]:
         """Every joint, in the order they were added."""

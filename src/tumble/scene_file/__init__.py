@@ -1,0 +1,168 @@
+"""Scene files: a world described in TOML (or the same structure in JSON), validated, built, written back.
+
+>>> from tumble import scene_file
+>>> loaded = scene_file.load(scene_file.shipped_scene("pendulum"))
+>>> loaded.run.dt, len(loaded.world.joints)
+(0.016666666666666666, 1)
+
+``load(path)`` reads and validates a file (pydantic: a wrong type, a value out of range, an unknown key or a
+missing mesh file is a :class:`SceneError` naming the file and the place, ``pile.toml: bodies[3].shape.extents:
+...``) and builds the :class:`~tumble.World`; nothing in the file is executed. ``World.to_scene()`` writes a
+world back as the same structure (:func:`dumps` makes it TOML or JSON text). See ``docs/scenes.md``.
+"""
+
+from __future__ import annotations
+
+import json
+import tomllib
+from dataclasses import dataclass
+from pathlib import Path
+
+from pydantic import ValidationError
+
+from . import schema
+from .build import SceneError, build_world
+from .dump import world_to_scene
+
+__all__ = ["LoadedScene", "RunSettings", "SceneError", "dumps", "from_dict", "load", "shipped", "shipped_scene"]
+
+SHIPPED_DIR = Path(__file__).resolve().parent.parent / "scene_files"
+
+
+@dataclass(frozen=True)
+class RunSettings:
+    """How the file asks to run it: step, duration, recording."""
+
+    dt: float
+    duration: float
+    record_every: int
+    output: str | None
+
+
+@dataclass(frozen=True)
+class LoadedScene:
+    """A loaded scene: the world built, the run settings, and the validated scene as a JSON-able dict."""
+
+    world: object
+    run: RunSettings
+    source: dict
+
+
+def _place(location: tuple) -> str:
+    """``('bodies', 3, 'shape', 'box', 'extents', 0)`` → ``bodies[3].shape.extents[0]`` (union tags dropped)."""
+    text = ""
+    for part in location:
+        if isinstance(part, int):
+            text += f"[{part}]"
+        elif part in _UNION_TAGS or part.startswith(("tuple[", "function-")):
+            continue
+        else:
+            text += f".{part}" if text else part
+    return text or "(top level)"
+
+
+_UNION_TAGS = {"sphere", "box", "capsule", "cylinder", "plane", "hull", "mesh", "ball", "hinge", "slider", "fixed",
+               "distance", "spring", "rope"}  # fmt: skip
+
+
+def _validation_message(label: str, error: ValidationError) -> str:
+    lines = []
+    for item in error.errors(include_url=False)[:5]:
+        message = item["msg"]
+        if item["type"] == "extra_forbidden":
+            message = "unknown key"
+        got = item.get("input")
+        shown = repr(got) if len(repr(got)) <= 60 else repr(got)[:57] + "..."
+        lines.append(f"{label}: {_place(item['loc'])}: {message} (got {shown})")
+    more = error.error_count() - len(lines)
+    return "\n".join(lines) + (f"\n{label}: ... and {more} more" if more > 0 else "")
+
+
+def from_dict(data: dict, *, base: Path | str = ".", label: str = "<scene>") -> LoadedScene:
+    """Validate and build a scene given as a dict (``label`` names it in errors; meshes relative to ``base``)."""
+    if not isinstance(data, dict):
+        raise SceneError(f"{label}: a scene must be a table (a dict), got {type(data).__name__}")
+    try:
+        scene = schema.Scene.model_validate(data)
+    except ValidationError as error:
+        raise SceneError(_validation_message(label, error)) from None
+    world = build_world(scene, Path(base), label)
+    run = RunSettings(scene.world.dt, scene.world.duration, scene.recording.every, scene.recording.path)
+    return LoadedScene(world, run, scene.model_dump(mode="json", exclude_none=True))
+
+
+def load(path) -> LoadedScene:
+    """Read, validate and build the scene file at ``path`` (``.toml`` or ``.json``)."""
+    path = Path(path)
+    label = path.name
+    if path.suffix not in (".toml", ".json"):
+        raise SceneError(f"{label}: a scene file must end in .toml or .json")
+    try:
+        text = path.read_text(encoding="utf-8")
+    except OSError as error:
+        raise SceneError(f"{label}: cannot read the file: {error.strerror or error}") from None
+    try:
+        data = tomllib.loads(text) if path.suffix == ".toml" else json.loads(text)
+    except (tomllib.TOMLDecodeError, json.JSONDecodeError) as error:
+        raise SceneError(f"{label}: not valid {path.suffix[1:].upper()}: {error}") from None
+    return from_dict(data, base=path.parent, label=label)
+
+
+def dumps(scene: dict, format: str = "toml") -> str:
+    """A scene dict (``World.to_scene()``) as TOML or JSON text."""
+    if format == "json":
+        return json.dumps(scene, indent=2)
+    if format != "toml":
+        raise ValueError(f"format must be 'toml' or 'json', got {format!r}")
+    return _toml(scene)
+
+
+def _toml_value(value) -> str:
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, (int, float)):
+        return repr(float(value)) if isinstance(value, float) else str(value)
+    if isinstance(value, str):
+        return json.dumps(value)
+    if isinstance(value, dict):
+        return "{ " + ", ".join(f"{k} = {_toml_value(v)}" for k, v in value.items() if v is not None) + " }"
+    return "[" + ", ".join(_toml_value(v) for v in value) + "]"
+
+
+def _toml(scene: dict) -> str:
+    lines = []
+    # Plain values first: in TOML they must come before the first table.
+    ordered = sorted(scene.items(), key=lambda item: isinstance(item[1], (dict, list)))
+    for key, value in ordered:
+        if isinstance(value, dict) and key != "materials":
+            lines.append(f"[{key}]")
+            lines += [f"{k} = {_toml_value(v)}" for k, v in value.items() if v is not None]
+        elif key == "materials":
+            for name, material in value.items():
+                lines.append(f"[materials.{name}]")
+                lines += [f"{k} = {_toml_value(v)}" for k, v in material.items()]
+        elif isinstance(value, list):
+            for item in value:
+                lines.append(f"[[{key}]]")
+                lines += [f"{k} = {_toml_value(v)}" for k, v in item.items() if v is not None]
+        else:
+            lines.append(f"{key} = {_toml_value(value)}")
+        lines.append("")
+    return "\n".join(lines)
+
+
+def shipped() -> list[Path]:
+    """The scene files shipped with tumble, sorted by name."""
+    return sorted(SHIPPED_DIR.glob("*.toml"))
+
+
+def shipped_scene(name: str) -> Path:
+    """The shipped scene file called ``name`` (without ``.toml``)."""
+    path = SHIPPED_DIR / f"{name}.toml"
+    if not path.is_file():
+        raise KeyError(f"no shipped scene {name!r}; scenes: {[p.stem for p in shipped()]}")
+    return path
+
+
+# Re-exported for World.to_scene.
+to_scene = world_to_scene

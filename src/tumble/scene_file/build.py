@@ -1,0 +1,154 @@
+"""A validated :class:`~tumble.scene_file.schema.Scene` turned into a :class:`~tumble.World`.
+
+Errors the world raises while a body or joint is added (a degenerate hull, a joint naming an unknown body)
+are re-raised as :class:`SceneError` with the place in the file (``bodies[3]``), as validation errors are.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from .. import joints as joint_types
+from ..shapes import Box, Capsule, ConvexHull, Cylinder, Plane, Sphere, TriMesh
+from ..world import World
+from . import schema
+
+__all__ = ["SceneError", "build_world"]
+
+
+class SceneError(ValueError):
+    """A scene file that cannot be read or built; the message names the file and the place in it."""
+
+
+def _mesh(shape: schema.MeshShape, base: Path, place: str, label: str) -> TriMesh:
+    if shape.path is None:
+        return TriMesh(np.array(shape.vertices, float), np.array(shape.faces, np.int64))
+    path = (base / shape.path).resolve()
+    if not path.is_file():
+        raise SceneError(f"{label}: {place}.path: no mesh file {shape.path!r} (looked for {path})")
+    try:
+        import trimesh
+    except ImportError as error:  # pragma: no cover - trimesh is in the mesh extra
+        raise SceneError(
+            f"{label}: {place}.path: reading mesh files needs trimesh (pip install tumble[mesh])"
+        ) from error
+    try:
+        mesh = trimesh.load(path, force="mesh")
+    except Exception as error:  # trimesh raises many kinds for unreadable files
+        raise SceneError(f"{label}: {place}.path: cannot read {shape.path!r}: {error}") from error
+    return TriMesh(np.asarray(mesh.vertices, float), np.asarray(mesh.faces, np.int64))
+
+
+def _shape(shape, base: Path, place: str, label: str):
+    if isinstance(shape, schema.SphereShape):
+        return Sphere(shape.radius)
+    if isinstance(shape, schema.BoxShape):
+        return Box(shape.extents)
+    if isinstance(shape, schema.CapsuleShape):
+        return Capsule(shape.radius, shape.length)
+    if isinstance(shape, schema.CylinderShape):
+        return Cylinder(shape.radius, shape.height)
+    if isinstance(shape, schema.PlaneShape):
+        return Plane(shape.normal, shape.offset)
+    if isinstance(shape, schema.HullShape):
+        return ConvexHull(np.array(shape.points, float))
+    return _mesh(shape, base, place, label)
+
+
+def _geometry(item: schema._Placed, base: Path, place: str, label: str):
+    if item.shape is not None:
+        return _shape(item.shape, base, f"{place}.shape", label)
+    if item.shapes is not None:
+        return [
+            (_shape(part.shape, base, f"{place}.shapes[{k}].shape", label), part.position, part.orientation)
+            for k, part in enumerate(item.shapes)
+        ]
+    return None
+
+
+def _material(item: schema._Placed, scene: schema.Scene, place: str, label: str) -> dict:
+    base = schema.Material()
+    if item.material is not None:
+        if item.material not in scene.materials:
+            raise SceneError(
+                f"{label}: {place}.material: no material {item.material!r}; materials: {sorted(scene.materials)}"
+            )
+        base = scene.materials[item.material]
+    values = base.model_dump()
+    for key in values:
+        given = getattr(item, key)
+        if given is not None:
+            values[key] = given
+    return values
+
+
+def _joint(spec, bodies: dict, place: str, label: str):
+    def body(key: str, name):
+        if name is None:
+            return None
+        if name not in bodies:
+            raise SceneError(f"{label}: {place}.{key}: no body named {name!r}; bodies: {sorted(bodies)}")
+        return bodies[name]
+
+    a, b = body("a", spec.a), body("b", spec.b)
+    options = spec.model_dump(exclude={"type", "a", "b"}, exclude_none=True)
+    if isinstance(spec, schema.BallJoint):
+        return joint_types.BallJoint(a, b, **options)
+    if isinstance(spec, schema.HingeJoint):
+        return joint_types.HingeJoint(a, b, **options)
+    if isinstance(spec, schema.SliderJoint):
+        return joint_types.SliderJoint(a, b, **options)
+    if isinstance(spec, schema.FixedJoint):
+        return joint_types.FixedJoint(a, b, **options)
+    if spec.type == "rope" and "min_length" not in options:
+        options["min_length"] = 0.0
+    return joint_types.DistanceJoint(a, b, **options)
+
+
+def build_world(scene: schema.Scene, base: Path, label: str) -> World:
+    """The world a validated scene describes; ``base`` is the directory mesh paths are relative to."""
+    settings = scene.world
+    solver = settings.model_dump(include={"substeps", "contact_hertz", "contact_damping_ratio", "joint_hertz",
+                                          "joint_damping_ratio", "sleep"}, exclude_none=True)  # fmt: skip
+    world = World(settings.gravity, integrator=settings.integrator, **solver)
+    named: dict = {}
+    for kind, items in (("bodies", scene.bodies), ("static", scene.static)):
+        for k, item in enumerate(items):
+            place = f"{kind}[{k}]"
+            try:
+                geometry = _geometry(item, base, place, label)
+                common = {
+                    "name": item.name,
+                    "position": item.position,
+                    "orientation": item.orientation,
+                    "collision_group": item.collision_group,
+                    "collision_mask": item.collision_mask,
+                    **_material(item, scene, place, label),
+                }
+                if kind == "bodies":
+                    inertia = None if item.inertia is None else np.array(item.inertia, float)
+                    if inertia is not None and inertia.ndim == 1:
+                        inertia = np.diag(inertia)
+                    body = world.add_body(geometry, mass=item.mass, density=item.density, inertia=inertia,
+                                          velocity=item.velocity, angular_velocity=item.angular_velocity,
+                                          linear_damping=item.linear_damping, angular_damping=item.angular_damping,
+                                          **common)  # fmt: skip
+                else:
+                    body = world.add_static(geometry, **common)
+            except SceneError:
+                raise
+            except (ValueError, TypeError) as error:
+                raise SceneError(f"{label}: {place}: {error}") from error
+            if item.name is not None:
+                named[item.name] = body
+    for k, spec in enumerate(scene.joints):
+        place = f"joints[{k}]"
+        try:
+            world.add_joint(_joint(spec, named, place, label))
+        except SceneError:
+            raise
+        except (ValueError, TypeError) as error:
+            raise SceneError(f"{label}: {place}: {error}") from error
+    return world

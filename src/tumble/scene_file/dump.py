@@ -1,0 +1,155 @@
+"""A world written back as a scene (``World.to_scene()``): the same structure as a scene file, at the current
+state, so that ``load`` of it builds the same bodies, shapes, materials and joints where they are now.
+
+Joints are re-created at the bodies' current poses, so their limits and spring targets are shifted by the
+current angle or translation (a hinge 0.3 rad into its range keeps its stops where they were). Meshes are
+written out as vertices and faces; bodies without a name get one (``body7``) so that joints can refer to them.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..rotation import quat_rotate
+from ..shapes import Box, Capsule, ConvexHull, Cylinder, Plane, Sphere, TriMesh
+
+__all__ = ["world_to_scene"]
+
+
+def _floats(values) -> list:
+    return np.asarray(values, dtype=float).tolist()
+
+
+def _shape(shape) -> dict:
+    if isinstance(shape, Sphere):
+        return {"type": "sphere", "radius": float(shape.radius)}
+    if isinstance(shape, Box):
+        return {"type": "box", "extents": _floats(shape.extents)}
+    if isinstance(shape, Capsule):
+        return {"type": "capsule", "radius": float(shape.radius), "length": float(shape.length)}
+    if isinstance(shape, Cylinder):
+        return {"type": "cylinder", "radius": float(shape.radius), "height": float(shape.height)}
+    if isinstance(shape, Plane):
+        return {"type": "plane", "normal": _floats(shape.normal), "offset": float(shape.offset)}
+    if isinstance(shape, ConvexHull):
+        return {"type": "hull", "points": _floats(shape.vertices)}
+    if isinstance(shape, TriMesh):
+        return {"type": "mesh", "vertices": _floats(shape.vertices), "faces": np.asarray(shape.faces).tolist()}
+    raise TypeError(f"cannot write shape {shape!r} to a scene")  # pragma: no cover - every shape is handled
+
+
+def _geometry(specs) -> dict:
+    if len(specs) == 1 and not np.any(specs[0].position) and np.allclose(specs[0].quat, (1.0, 0.0, 0.0, 0.0)):
+        return {"shape": _shape(specs[0].shape)}
+    return {"shapes": [{"shape": _shape(s.shape), "position": _floats(s.position), "orientation": _floats(s.quat)}
+                       for s in specs]}  # fmt: skip
+
+
+def _names(world) -> list[str]:
+    taken = {b.name for b in world.bodies if b.name is not None}
+    names = []
+    for body in world.bodies:
+        name = body.name
+        if name is None:
+            name, k = f"body{body.index}", 0
+            while name in taken:
+                k += 1
+                name = f"body{body.index}_{k}"
+            taken.add(name)
+        names.append(name)
+    return names
+
+
+def _placed(world, body, name: str) -> dict:
+    row = world._builder.rows[body.index]
+    entry = {"name": name, **(_geometry(row.shapes) if row.shapes else {})}
+    entry["position"], entry["orientation"] = _floats(body.position), _floats(body.orientation)
+    if row.shapes:
+        first = row.shapes[0]
+        entry.update(friction=first.friction, restitution=first.restitution,
+                     rolling_resistance=first.rolling_resistance, collision_group=int(first.group),
+                     collision_mask=int(first.mask))  # fmt: skip
+    return entry
+
+
+def _body(world, body, name: str) -> dict:
+    row = world._builder.rows[body.index]
+    entry = _placed(world, body, name)
+    mp = row.mass_properties
+    entry.update(mass=float(mp.mass), inertia=_floats(mp.inertia), velocity=_floats(body.velocity),
+                 angular_velocity=_floats(body.angular_velocity), linear_damping=float(row.linear_damping),
+                 angular_damping=float(row.angular_damping))  # fmt: skip
+    return entry
+
+
+def _bounds(lower: float, upper: float, shift: float) -> dict:
+    out = {}
+    if math.isfinite(lower):
+        out["lower"] = lower - shift
+    if math.isfinite(upper):
+        out["upper"] = upper - shift
+    return out
+
+
+def _joint(joint, names: list[str]) -> dict:
+    spec = joint._world._builder.joints[joint.index]
+    lower, upper, speed, max_motor, hertz, ratio, target, cone = (float(v) for v in spec.drive)
+    a, b = joint.body_a, joint.body_b
+    entry = {"type": joint.kind, "a": names[a.index], "b": None if b is None else names[b.index]}
+    if spec.collide_connected:
+        entry["collide_connected"] = True
+    anchor = _floats(joint.anchor_a)
+    frame_body = spec.body_a if spec.body_a >= 0 else -1
+    state = joint._world.state
+    frame = spec.local_frame_a if frame_body < 0 else None
+    if frame_body >= 0:
+        from ..rotation import quat_multiply
+
+        frame = quat_multiply(state.body_quat[frame_body], spec.local_frame_a)
+    axis = _floats(quat_rotate(frame, (1.0, 0.0, 0.0)))
+    if joint.kind == "ball":
+        entry["anchor"] = anchor
+        if math.isfinite(cone) or math.isfinite(lower) or math.isfinite(upper):
+            entry["axis"] = axis
+            entry.update({f"twist_{k}": v for k, v in _bounds(lower, upper, joint.twist).items()})
+            if math.isfinite(cone):
+                entry["cone_angle"] = cone
+    elif joint.kind in ("hinge", "slider"):
+        shift = joint.angle if joint.kind == "hinge" else joint.translation
+        entry.update(anchor=anchor, axis=axis, motor_speed=speed, spring_hertz=hertz, spring_damping_ratio=ratio,
+                     spring_target=target - shift, **_bounds(lower, upper, shift))  # fmt: skip
+        entry["max_motor_torque" if joint.kind == "hinge" else "max_motor_force"] = max_motor
+    elif joint.kind == "fixed":
+        entry["anchor"] = anchor
+    else:
+        entry.update(anchor_a=anchor, anchor_b=_floats(joint.anchor_b), length=target, min_length=lower,
+                     max_length=upper, spring_hertz=hertz, spring_damping_ratio=ratio)  # fmt: skip
+    return entry
+
+
+def world_to_scene(world, *, dt: float | None = None, duration: float | None = None) -> dict:
+    """The scene dict of ``world`` now (``dt`` and ``duration`` default to the scene defaults)."""
+    names = _names(world)
+    solver = world.solver
+    settings = {
+        "gravity": _floats(world.gravity),
+        "integrator": world.integrator,
+        "substeps": int(solver.substeps),
+        "contact_hertz": float(solver.contact_hertz),
+        "contact_damping_ratio": float(solver.contact_damping_ratio),
+        "joint_hertz": float(solver.joint_hertz),
+        "joint_damping_ratio": float(solver.joint_damping_ratio),
+        "sleep": bool(solver.sleep),
+    }
+    if dt is not None:
+        settings["dt"] = float(dt)
+    if duration is not None:
+        settings["duration"] = float(duration)
+    return {
+        "world": settings,
+        "bodies": [_body(world, b, names[b.index]) for b in world.bodies if not b.is_static],
+        "static": [_placed(world, b, names[b.index]) for b in world.bodies if b.is_static],
+        "joints": [_joint(j, names) for j in world.joints],
+    }

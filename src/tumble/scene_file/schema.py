@@ -1,0 +1,251 @@
+"""The scene file's structure, as pydantic models: what may be written where, with its type and range.
+
+One structure serves TOML and JSON. Unknown keys are errors (a typo must not be silently ignored). Vectors are
+lists of numbers; quaternions ``[w, x, y, z]``; angles in radians; SI units throughout.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Annotated, Literal
+
+from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
+
+Vector3 = tuple[float, float, float]
+Quaternion = tuple[float, float, float, float]
+Positive = Annotated[float, Field(gt=0.0, allow_inf_nan=False)]
+NonNegative = Annotated[float, Field(ge=0.0, allow_inf_nan=False)]
+Finite = Annotated[float, Field(allow_inf_nan=False)]
+Bits = Annotated[int, Field(ge=0, le=0xFFFFFFFF)]
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+# --- shapes --------------------------------------------------------------------------------------------
+
+
+class SphereShape(_Strict):
+    type: Literal["sphere"]
+    radius: Positive
+
+
+class BoxShape(_Strict):
+    type: Literal["box"]
+    extents: tuple[Positive, Positive, Positive]
+
+
+class CapsuleShape(_Strict):
+    type: Literal["capsule"]
+    radius: Positive
+    length: NonNegative
+
+
+class CylinderShape(_Strict):
+    type: Literal["cylinder"]
+    radius: Positive
+    height: Positive
+
+
+class PlaneShape(_Strict):
+    type: Literal["plane"]
+    normal: Vector3 = (0.0, 0.0, 1.0)
+    offset: Finite = 0.0
+
+
+class HullShape(_Strict):
+    type: Literal["hull"]
+    points: list[Vector3] = Field(min_length=4)
+
+
+class MeshShape(_Strict):
+    """A triangle mesh: a file (STL, OBJ, … read with trimesh; the path relative to the scene file) or the
+    vertices and faces written out."""
+
+    type: Literal["mesh"]
+    path: str | None = None
+    vertices: list[Vector3] | None = None
+    faces: list[tuple[int, int, int]] | None = None
+
+    @model_validator(mode="after")
+    def _one_source(self):
+        if (self.path is None) == (self.vertices is None):
+            raise ValueError("give either path or vertices and faces")
+        if (self.vertices is None) != (self.faces is None):
+            raise ValueError("vertices and faces go together")
+        return self
+
+
+Shape = Annotated[
+    SphereShape | BoxShape | CapsuleShape | CylinderShape | PlaneShape | HullShape | MeshShape,
+    Field(discriminator="type"),
+]
+
+
+class Part(_Strict):
+    """One shape of a compound body, placed in the body frame."""
+
+    shape: Shape
+    position: Vector3 = (0.0, 0.0, 0.0)
+    orientation: Quaternion = (1.0, 0.0, 0.0, 0.0)
+
+
+# --- materials and bodies ------------------------------------------------------------------------------
+
+
+class Material(_Strict):
+    friction: NonNegative = 0.5
+    restitution: Annotated[float, Field(ge=0.0, le=1.0)] = 0.0
+    rolling_resistance: NonNegative = 0.0
+
+
+class _Placed(_Strict):
+    name: str | None = Field(default=None, min_length=1)
+    shape: Shape | None = None
+    shapes: list[Part] | None = None
+    position: Vector3 = (0.0, 0.0, 0.0)
+    orientation: Quaternion = (1.0, 0.0, 0.0, 0.0)
+    material: str | None = None
+    friction: NonNegative | None = None
+    restitution: Annotated[float, Field(ge=0.0, le=1.0)] | None = None
+    rolling_resistance: NonNegative | None = None
+    collision_group: Bits = 1
+    collision_mask: Bits = 0xFFFFFFFF
+
+    @model_validator(mode="after")
+    def _one_geometry(self):
+        if self.shape is not None and self.shapes is not None:
+            raise ValueError("give shape or shapes, not both")
+        return self
+
+
+class Body(_Placed):
+    """A dynamic body: ``mass`` or ``density`` (with geometry), or ``mass`` and ``inertia`` (without)."""
+
+    mass: Positive | None = None
+    density: Positive | None = None
+    inertia: Vector3 | tuple[Vector3, Vector3, Vector3] | None = None
+    velocity: Vector3 = (0.0, 0.0, 0.0)
+    angular_velocity: Vector3 = (0.0, 0.0, 0.0)
+    linear_damping: NonNegative = 0.0
+    angular_damping: NonNegative = 0.0
+
+    @model_validator(mode="after")
+    def _mass(self):
+        if (self.mass is None) == (self.density is None):
+            raise ValueError("give exactly one of mass and density")
+        if self.shape is None and self.shapes is None and (self.mass is None or self.inertia is None):
+            raise ValueError("a body without shape needs mass and inertia")
+        return self
+
+
+class Static(_Placed):
+    """Fixed geometry: planes, meshes, any shape."""
+
+    @model_validator(mode="after")
+    def _geometry(self):
+        if self.shape is None and self.shapes is None:
+            raise ValueError("static geometry needs shape or shapes")
+        return self
+
+
+# --- joints -------------------------------------------------------------------------------------------
+
+
+class _Joint(_Strict):
+    a: str = Field(min_length=1)
+    b: str | None = None  # None or "world": the world
+    collide_connected: bool = False
+
+    @field_validator("b")
+    @classmethod
+    def _world(cls, value):
+        return None if value == "world" else value
+
+
+class BallJoint(_Joint):
+    type: Literal["ball"]
+    anchor: Vector3
+    axis: Vector3 | None = None
+    cone_angle: Annotated[float, Field(gt=0.0, le=math.pi)] | None = None
+    twist_lower: Annotated[float, Field(ge=-math.pi, le=math.pi)] | None = None
+    twist_upper: Annotated[float, Field(ge=-math.pi, le=math.pi)] | None = None
+
+
+class _Drive(_Joint):
+    lower: Finite | None = None
+    upper: Finite | None = None
+    motor_speed: Finite = 0.0
+    spring_hertz: NonNegative = 0.0
+    spring_damping_ratio: NonNegative = 0.0
+    spring_target: Finite = 0.0
+
+
+class HingeJoint(_Drive):
+    type: Literal["hinge"]
+    anchor: Vector3
+    axis: Vector3
+    max_motor_torque: NonNegative = 0.0
+
+
+class SliderJoint(_Drive):
+    type: Literal["slider"]
+    axis: Vector3
+    anchor: Vector3 | None = None
+    max_motor_force: NonNegative = 0.0
+
+
+class FixedJoint(_Joint):
+    type: Literal["fixed"]
+    anchor: Vector3 | None = None
+
+
+class DistanceJoint(_Joint):
+    """A rod (default), a rope (``min_length = 0``) or, with ``spring_hertz > 0``, a spring."""
+
+    type: Literal["distance", "spring", "rope"]
+    anchor_a: Vector3
+    anchor_b: Vector3
+    length: NonNegative | None = None
+    min_length: NonNegative | None = None
+    max_length: NonNegative | None = None
+    spring_hertz: NonNegative = 0.0
+    spring_damping_ratio: NonNegative = 0.0
+
+
+Joint = Annotated[BallJoint | HingeJoint | SliderJoint | FixedJoint | DistanceJoint, Field(discriminator="type")]
+
+
+# --- the whole file ---------------------------------------------------------------------------------
+
+
+class WorldSettings(_Strict):
+    gravity: Vector3 = (0.0, 0.0, -9.81)
+    dt: Positive = 1.0 / 60.0
+    duration: Positive = 5.0
+    integrator: Literal["auto", "euler", "symplectic", "rk4", "midpoint"] = "auto"
+    substeps: Annotated[int, Field(ge=1, le=1000)] | None = None
+    contact_hertz: Positive | None = None
+    contact_damping_ratio: NonNegative | None = None
+    joint_hertz: Positive | None = None
+    joint_damping_ratio: NonNegative | None = None
+    sleep: bool | None = None
+
+
+class Recording(_Strict):
+    every: Annotated[int, Field(ge=1)] = 1
+    path: str | None = None
+
+
+class Scene(_Strict):
+    """A scene file: ``[world]``, ``[materials.NAME]``, ``[[bodies]]``, ``[[static]]``, ``[[joints]]``,
+    ``[recording]``, and a free-text ``description``."""
+
+    description: str = ""
+    world: WorldSettings = WorldSettings()
+    materials: dict[str, Material] = {}
+    bodies: list[Body] = []
+    static: list[Static] = []
+    joints: list[Joint] = []
+    recording: Recording = Recording()

@@ -1,0 +1,196 @@
+"""Scene files: every shipped scene loads, runs and round-trips; bad files give clean errors naming the place."""
+
+from __future__ import annotations
+
+import copy
+import json
+import math
+import tomllib
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+import tumble
+from tumble import scene_file, scenes
+from tumble.scene_file import SceneError
+
+SHIPPED = scene_file.shipped()
+
+
+def test_the_package_ships_a_scene_for_every_capability():
+    names = {path.stem for path in SHIPPED}
+    assert {
+        "pendulum",
+        "dzhanibekov",
+        "box_pile",
+        "pyramid",
+        "dominoes",
+        "newtons_cradle",
+        "pendulum_chain",
+        "slider_crank",
+        "four_bar",
+        "hinged_door",
+        "rope_bridge",
+        "ragdoll_stairs",
+        "mixed_pile",
+    } <= names
+    assert scenes.files() == SHIPPED
+
+
+@pytest.mark.slow  # stepping 13 scenes is minutes without the JIT
+@pytest.mark.parametrize("path", SHIPPED, ids=[p.stem for p in SHIPPED])
+def test_every_shipped_scene_loads_runs_and_round_trips(path):
+    loaded = scene_file.load(path)
+    world = loaded.world
+    assert tomllib.loads(path.read_text())["description"]
+    again = scene_file.from_dict(tomllib.loads(scene_file.dumps(world.to_scene(dt=loaded.run.dt))), base=path.parent)
+    twin = again.world
+    np.testing.assert_allclose(twin.model.body_mass, world.model.body_mass, rtol=1e-12)
+    np.testing.assert_allclose(twin.model.body_inertia_local, world.model.body_inertia_local, rtol=1e-9, atol=1e-15)
+    np.testing.assert_allclose(twin.state.body_pos, world.state.body_pos, atol=1e-12)
+    np.testing.assert_allclose(twin.model.shape_params, world.model.shape_params, atol=1e-12)
+    assert len(twin.joints) == len(world.joints) and again.run.dt == loaded.run.dt
+    for w in (world, twin):
+        for _ in range(3):
+            w.step(loaded.run.dt)
+    np.testing.assert_allclose(twin.state.body_pos, world.state.body_pos, atol=1e-9)
+
+
+def test_json_and_toml_are_the_same_structure(tmp_path):
+    data = tomllib.loads(scene_file.shipped_scene("slider_crank").read_text())
+    path = tmp_path / "crank.json"
+    path.write_text(json.dumps(data))
+    from_json = scene_file.load(path)
+    from_toml = scene_file.load(scene_file.shipped_scene("slider_crank"))
+    assert from_json.source == from_toml.source
+    assert tumble.load_scene(path).state.digest() == from_toml.world.state.digest()
+
+
+def _write(tmp_path, text: str, name: str = "bad.toml"):
+    path = tmp_path / name
+    path.write_text(text)
+    return path
+
+
+GOOD = """
+[world]
+dt = 0.01
+[materials.rubber]
+friction = 0.9
+restitution = 0.7
+[[static]]
+shape = { type = "plane" }
+[[bodies]]
+name = "ball"
+shape = { type = "sphere", radius = 0.1 }
+mass = 1.0
+position = [0, 0, 1]
+material = "rubber"
+[[bodies]]
+name = "box"
+shape = { type = "box", extents = [0.2, 0.2, 0.2] }
+density = 500.0
+position = [1, 0, 1]
+"""
+
+
+@pytest.mark.parametrize(
+    ("edit", "expected"),
+    [
+        (
+            lambda t: t.replace("extents = [0.2, 0.2, 0.2]", 'extents = [0.2, "x", 0.2]'),
+            r"bad.toml: bodies\[1\].shape.extents\[1\]: .*number",
+        ),
+        (lambda t: t.replace("radius = 0.1", "radius = -0.1"), r"bad.toml: bodies\[0\].shape.radius: .*greater than 0"),
+        (lambda t: t.replace("mass = 1.0", "mass = -2.0"), r"bad.toml: bodies\[0\].mass: .*greater than 0"),
+        (
+            lambda t: t.replace("density = 500.0", "density = 500.0\ncolour = 3"),
+            r"bad.toml: bodies\[1\].colour: unknown key",
+        ),
+        (
+            lambda t: t.replace('material = "rubber"', 'material = "steel"'),
+            r"bad.toml: bodies\[0\].material: no material 'steel'; materials: \['rubber'\]",
+        ),
+        (lambda t: t.replace("[world]", "[world"), r"bad.toml: not valid TOML"),
+        (
+            lambda t: t.replace('shape = { type = "plane" }', 'shape = { type = "mesh", path = "bowl.stl" }'),
+            r"bad.toml: static\[0\].shape.path: no mesh file 'bowl.stl'",
+        ),
+        (lambda t: t.replace('type = "sphere"', 'type = "blob"'), r"bad.toml: bodies\[0\].shape: .*sphere"),
+        (
+            lambda t: t + '[[joints]]\ntype = "hinge"\na = "nobody"\nanchor = [0, 0, 0]\naxis = [0, 1, 0]\n',
+            r"bad.toml: joints\[0\].a: no body named 'nobody'",
+        ),
+        (
+            lambda t: t + '[[joints]]\ntype = "hinge"\na = "ball"\nanchor = [0, 0, 0]\naxis = [0, 0, 0]\n',
+            r"bad.toml: joints\[0\]: axis must be a non-zero vector",
+        ),
+        (
+            lambda t: t.replace(
+                'shape = { type = "box", extents = [0.2, 0.2, 0.2] }',
+                'shape = { type = "hull", points = [[0,0,0],[1,0,0],[0,1,0],[1,1,0]] }',
+            ),
+            r"bad.toml: bodies\[1\]: points must span a volume",
+        ),
+    ],
+)
+def test_bad_files_name_the_file_and_the_place(tmp_path, edit, expected):
+    with pytest.raises(SceneError, match=expected):
+        scene_file.load(_write(tmp_path, edit(GOOD)))
+
+
+def test_a_good_file_builds_what_it_says(tmp_path):
+    loaded = scene_file.load(_write(tmp_path, GOOD, "good.toml"))
+    world = loaded.world
+    assert loaded.run.dt == 0.01 and loaded.run.duration == 5.0
+    ball, box = world.body("ball"), world.body("box")
+    assert ball.mass == 1.0 and box.mass == pytest.approx(500.0 * 0.008)
+    ball_shape = int(np.flatnonzero(world.model.shape_body == ball.index)[0])
+    assert world.model.shape_restitution[ball_shape] == 0.7 and world.model.shape_friction[ball_shape] == 0.9
+    with pytest.raises(SceneError, match=r"missing.toml: cannot read the file"):
+        scene_file.load(tmp_path / "missing.toml")
+    with pytest.raises(SceneError, match=r"scene.yaml: a scene file must end in .toml or .json"):
+        scene_file.load(tmp_path / "scene.yaml")
+
+
+JUNK = st.one_of(st.none(), st.booleans(), st.integers(-3, 3), st.floats(allow_nan=True, allow_infinity=True),
+                 st.text(max_size=3), st.lists(st.floats(-2, 2), max_size=4), st.dictionaries(st.text(max_size=2),
+                 st.integers(), max_size=2))  # fmt: skip
+
+
+def _paths(node, prefix=()):
+    yield prefix
+    if isinstance(node, dict):
+        for key, value in node.items():
+            yield from _paths(value, (*prefix, key))
+    elif isinstance(node, list):
+        for k, value in enumerate(node):
+            yield from _paths(value, (*prefix, k))
+
+
+BASE = tomllib.loads(
+    GOOD + '[[joints]]\ntype = "hinge"\na = "ball"\nb = "box"\nanchor = [0.5, 0, 1]\naxis = [0, 1, 0]\n'
+)
+PATHS = [p for p in _paths(BASE) if p]
+
+
+@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(st.lists(st.tuples(st.sampled_from(PATHS), JUNK), min_size=1, max_size=3))
+def test_random_mutations_give_clean_errors_or_valid_worlds(mutations):
+    data = copy.deepcopy(BASE)
+    for path, junk in mutations:
+        node = data
+        try:
+            for key in path[:-1]:
+                node = node[key]
+            node[path[-1]] = junk
+        except (KeyError, IndexError, TypeError):
+            continue
+    try:
+        world = scene_file.from_dict(data, label="mutant").world
+    except SceneError as error:
+        assert str(error).startswith("mutant:")
+        return
+    assert all(math.isfinite(m) for m in world.model.body_mass)
