@@ -57,6 +57,8 @@ class _BodyRow:
     linear_damping: float
     angular_damping: float
     name: str | None
+    constant_force: np.ndarray = field(default_factory=lambda: np.zeros(3))  # [N] world frame, at the COM
+    constant_torque: np.ndarray = field(default_factory=lambda: np.zeros(3))  # [N m] world frame
 
 
 @dataclass
@@ -144,6 +146,8 @@ class ModelBuilder:
             shape_mask=np.array([s.mask for _, s in specs], dtype=np.uint32),
             has_contacts=_contacts_possible(specs, is_dynamic),
             shapes=tuple(s.shape for _, s in specs),
+            body_constant_force=np.array([r.constant_force for r in self.rows], np.float64).reshape(n, 3),
+            body_constant_torque=np.array([r.constant_torque for r in self.rows], np.float64).reshape(n, 3),
             joints=joints,
             joint_exclusions=joint_exclusions,
         )

@@ -193,6 +193,32 @@ class Body:
         inputs.body_force[self._index] += force
         inputs.body_torque[self._index] += moment
 
+    @property
+    def constant_force(self) -> np.ndarray:
+        """(3,) [N] a force that acts at the centre of mass in every step (world frame; settable; zero by
+        default): thrust, wind, a spring to a fixed point's rest force. ``apply_force`` acts in one step."""
+        return self._world._builder.rows[self._index].constant_force.copy()
+
+    @constant_force.setter
+    def constant_force(self, value) -> None:
+        self._set_constant("constant_force", as_vector3("constant_force", value))
+
+    @property
+    def constant_torque(self) -> np.ndarray:
+        """(3,) [N m] a torque that acts in every step (world frame; settable; zero by default)."""
+        return self._world._builder.rows[self._index].constant_torque.copy()
+
+    @constant_torque.setter
+    def constant_torque(self, value) -> None:
+        self._set_constant("constant_torque", as_vector3("constant_torque", value))
+
+    def _set_constant(self, name: str, value: np.ndarray) -> None:
+        self._require_dynamic(name)
+        setattr(self._world._builder.rows[self._index], name, value)
+        model = self._world._model
+        if model is not None:
+            getattr(model, f"body_{name}")[self._index] = value
+
     def apply_torque(self, torque) -> None:
         """Apply ``torque`` [N m] (world frame) during the next step only."""
         torque = as_vector3("torque", torque)

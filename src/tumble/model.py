@@ -28,6 +28,8 @@ class BodyArrays(NamedTuple):
     is_dynamic: np.ndarray  # (n,) bool
     linear_damping: np.ndarray  # (n,) [1/s]
     angular_damping: np.ndarray  # (n,) [1/s]
+    constant_force: np.ndarray  # (n, 3) [N] world frame, at the COM, every step
+    constant_torque: np.ndarray  # (n, 3) [N m] world frame, every step
 
 
 @dataclass(frozen=True, eq=False)
@@ -53,6 +55,8 @@ class Model:
         shape_group, shape_mask: (shape_count,) uint32 collision filter bits.
         has_contacts: whether two shapes of different bodies can touch (then the contact solver steps).
         shapes: the shape objects, in row order (for geometry that does not fit the arrays).
+        body_constant_force, body_constant_torque: (body_count, 3) [N], [N m] loads that act in every step (world
+            frame; the force at the centre of mass), set with ``Body.constant_force`` and ``constant_torque``.
         joints: the world joints (:class:`~tumble.dynamics.joint_solver.JointArrays`; body -1 is the world).
         joint_exclusions: (k, 2) int64 sorted body pairs that a joint keeps from colliding.
     """
@@ -76,6 +80,8 @@ class Model:
     shape_mask: np.ndarray
     has_contacts: bool
     shapes: tuple
+    body_constant_force: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
+    body_constant_torque: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
     joints: JointArrays = field(default_factory=JointArrays.empty)
     joint_exclusions: np.ndarray = field(default_factory=lambda: np.zeros((0, 2), np.int64))
 
@@ -122,6 +128,8 @@ class Model:
             self.body_is_dynamic,
             self.body_linear_damping,
             self.body_angular_damping,
+            self.body_constant_force,
+            self.body_constant_torque,
         )
 
     @cached_property

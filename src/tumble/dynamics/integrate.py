@@ -21,7 +21,7 @@ from typing import NamedTuple
 import numpy as np
 
 from .._jit import inline, kernel
-from ..math3d import is_finite3, load3, load4, load33, quat_is_finite, scale, store3, store4
+from ..math3d import add_scaled, is_finite3, load3, load4, load33, quat_is_finite, store3, store4
 from ..model import Model
 from ..params import Integrator
 from ..state import State
@@ -64,18 +64,20 @@ def _advance_body(i, bodies, gravity, force, torque, pos, quat, linvel, angmom, 
     inv_inertia = load33(bodies.inv_inertia_local, i)
     c_lin = bodies.linear_damping[i]
     c_ang = bodies.angular_damping[i]
-    weight = scale((gravity[0], gravity[1], gravity[2]), bodies.mass[i])
+    # Gravity and the constant loads act in every step; applied loads in the first step only.
+    weight = add_scaled(load3(bodies.constant_force, i), (gravity[0], gravity[1], gravity[2]), bodies.mass[i])
+    steady_torque = load3(bodies.constant_torque, i)
     applied_force = load3(force, i)
     applied_torque = load3(torque, i)
     x, q, v, l = load3(pos, i), load4(quat, i), load3(linvel, i), load3(angmom, i)
     failed = -1
     for s in range(n_steps):
-        # Applied loads act during the first step only; gravity during all of them.
         f = (weight[0] + applied_force[0], weight[1] + applied_force[1], weight[2] + applied_force[2])
-        t = applied_torque
+        t = (steady_torque[0] + applied_torque[0], steady_torque[1] + applied_torque[1],
+             steady_torque[2] + applied_torque[2])  # fmt: skip
         if s > 0:
             f = weight
-            t = (0.0, 0.0, 0.0)
+            t = steady_torque
         if method == 0:
             xn, qn, vn, ln = euler_step(x, q, v, l, inv_m, inertia, inv_inertia, f, t, c_lin, c_ang, h)
         elif method == 1:

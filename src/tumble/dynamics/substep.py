@@ -12,6 +12,7 @@ import os
 
 from .._jit import kernel
 from ..math3d import (
+    add,
     add_scaled,
     load3,
     load4,
@@ -64,13 +65,15 @@ def integrate_velocities(bodies, moving, gravity, force, torque, quat, linvel, a
     for i in range(quat.shape[0]):
         if not moving[i]:
             continue
-        accel = add_scaled((gravity[0], gravity[1], gravity[2]), load3(force, i), bodies.inv_mass[i])
+        applied = add(load3(force, i), load3(bodies.constant_force, i))
+        accel = add_scaled((gravity[0], gravity[1], gravity[2]), applied, bodies.inv_mass[i])
         v = scale(add_scaled(load3(linvel, i), accel, h), 1.0 / (1.0 + h * bodies.linear_damping[i]))
         store3(linvel, i, v)
         q = load4(quat, i)
         w_body = quat_rotate_inv(q, load3(angvel, i))
         inertia = load33(bodies.inertia_local, i)
-        w_body = implicit_spin(q, w_body, inertia, load3(torque, i), bodies.angular_damping[i], h)
+        spin = add(load3(torque, i), load3(bodies.constant_torque, i))
+        w_body = implicit_spin(q, w_body, inertia, spin, bodies.angular_damping[i], h)
         store3(angvel, i, quat_rotate(q, w_body))
 
 

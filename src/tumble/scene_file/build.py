@@ -135,6 +135,8 @@ def build_world(scene: schema.Scene, base: Path, label: str) -> World:
                                           velocity=item.velocity, angular_velocity=item.angular_velocity,
                                           linear_damping=item.linear_damping, angular_damping=item.angular_damping,
                                           **common)  # fmt: skip
+                    body.constant_force = item.constant_force
+                    body.constant_torque = item.constant_torque
                 else:
                     body = world.add_static(geometry, **common)
             except SceneError:

@@ -81,6 +81,8 @@ def _body(world, body, name: str) -> dict:
     entry.update(mass=float(mp.mass), inertia=_floats(mp.inertia), velocity=_floats(body.velocity),
                  angular_velocity=_floats(body.angular_velocity), linear_damping=float(row.linear_damping),
                  angular_damping=float(row.angular_damping))  # fmt: skip
+    if np.any(row.constant_force) or np.any(row.constant_torque):
+        entry.update(constant_force=_floats(row.constant_force), constant_torque=_floats(row.constant_torque))
     return entry
 
 

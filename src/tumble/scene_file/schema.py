@@ -130,6 +130,8 @@ class Body(_Placed):
     angular_velocity: Vector3 = (0.0, 0.0, 0.0)
     linear_damping: NonNegative = 0.0
     angular_damping: NonNegative = 0.0
+    constant_force: Vector3 = (0.0, 0.0, 0.0)  # [N] world frame, at the COM, in every step
+    constant_torque: Vector3 = (0.0, 0.0, 0.0)  # [N m] world frame, in every step
 
     @model_validator(mode="after")
     def _mass(self):
