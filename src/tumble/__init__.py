@@ -29,6 +29,7 @@ def load_scene(path) -> World:
 
     return load(path).world
 
+
 __all__ = [
     "Articulation",
     "Ball",
