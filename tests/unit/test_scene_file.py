@@ -47,15 +47,20 @@ def test_every_shipped_scene_loads_runs_and_round_trips(path):
     assert tomllib.loads(path.read_text())["description"]
     again = scene_file.from_dict(tomllib.loads(scene_file.dumps(world.to_scene(dt=loaded.run.dt))), base=path.parent)
     twin = again.world
-    np.testing.assert_allclose(twin.model.body_mass, world.model.body_mass, rtol=1e-12)
-    np.testing.assert_allclose(twin.model.body_inertia_local, world.model.body_inertia_local, rtol=1e-9, atol=1e-15)
-    np.testing.assert_allclose(twin.state.body_pos, world.state.body_pos, atol=1e-12)
-    np.testing.assert_allclose(twin.model.shape_params, world.model.shape_params, atol=1e-12)
+    # The scene lists dynamic bodies before static ones: the twin's rows follow that order.
+    order = [b.index for b in world.bodies if not b.is_static] + [b.index for b in world.bodies if b.is_static]
+    np.testing.assert_allclose(twin.model.body_mass, world.model.body_mass[order], rtol=1e-12)
+    np.testing.assert_allclose(twin.model.body_inertia_local, world.model.body_inertia_local[order], rtol=1e-9,
+                               atol=1e-15)  # fmt: skip
+    np.testing.assert_allclose(twin.state.body_pos, world.state.body_pos[order], atol=1e-12)
+    for mine, theirs in enumerate(order):
+        np.testing.assert_allclose(twin.model.shape_params[twin.model.shape_body == mine],
+                                   world.model.shape_params[world.model.shape_body == theirs], atol=1e-12)  # fmt: skip
     assert len(twin.joints) == len(world.joints) and again.run.dt == loaded.run.dt
     for w in (world, twin):
         for _ in range(3):
             w.step(loaded.run.dt)
-    np.testing.assert_allclose(twin.state.body_pos, world.state.body_pos, atol=1e-9)
+    np.testing.assert_allclose(twin.state.body_pos, world.state.body_pos[order], atol=1e-9)
 
 
 def test_json_and_toml_are_the_same_structure(tmp_path):
@@ -194,3 +199,19 @@ def test_random_mutations_give_clean_errors_or_valid_worlds(mutations):
         assert str(error).startswith("mutant:")
         return
     assert all(math.isfinite(m) for m in world.model.body_mass)
+
+
+def test_an_articulation_in_a_scene_becomes_bodies_and_joints(tmp_path):
+    loaded = scene_file.load(scene_file.shipped_scene("robot_arm"))
+    world = loaded.world
+    assert [b.name for b in world.bodies if b.name.startswith("arm/")] == ["arm/shoulder", "arm/elbow", "arm/wrist"]
+    assert [j.kind for j in world.joints] == ["hinge"] * 3
+    assert world.joints[0].body_a.name == "arm/shoulder" and world.joints[0].body_b is None
+    bad = GOOD + '[[articulations]]\nname = "a"\n[[articulations.links]]\nname = "l"\nparent = "nope"\n'
+    bad += 'joint = { type = "revolute", axis = [0, 1, 0] }\nmass = 1.0\n'
+    with pytest.raises(SceneError, match=r"bad.toml: articulations\[0\].links\[0\].parent: no earlier link named"):
+        scene_file.load(_write(tmp_path, bad))
+    bad = GOOD + '[[articulations]]\nname = "a"\n[[articulations.links]]\nname = "l"\n'
+    bad += 'joint = { type = "ball", axis = [0, 1, 0] }\n'
+    with pytest.raises(SceneError, match=r"articulations\[0\].links\[0\].joint: .*take none"):
+        scene_file.load(_write(tmp_path, bad))

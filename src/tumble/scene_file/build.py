@@ -107,6 +107,33 @@ def _joint(spec, bodies: dict, place: str, label: str):
     return joint_types.DistanceJoint(a, b, **options)
 
 
+def _articulation(spec: schema.Articulation, gravity, base: Path, place: str, label: str):
+    from ..articulation import Articulation, Ball, Fixed, Free, Prismatic, Revolute
+
+    kinds = {"revolute": Revolute, "prismatic": Prismatic, "ball": Ball, "free": Free, "fixed": Fixed}
+    art = Articulation(gravity, spec.base_position, spec.base_orientation, name=spec.name)
+    index: dict[str, int] = {}
+    for k, link in enumerate(spec.links):
+        where = f"{place}.links[{k}]"
+        if link.parent is not None and link.parent not in index:
+            raise SceneError(f"{label}: {where}.parent: no earlier link named {link.parent!r}; links: {sorted(index)}")
+        joint = kinds[link.joint.type](link.joint.axis) if link.joint.axis is not None else kinds[link.joint.type]()
+        shape = None if link.shape is None else _shape(link.shape, base, f"{where}.shape", label)
+        try:
+            index[link.name] = art.add_link(
+                joint, parent=None if link.parent is None else index[link.parent], position=link.position,
+                orientation=link.orientation, shape=shape, mass=link.mass, density=link.density,
+                shape_position=link.shape_position, shape_orientation=link.shape_orientation, name=link.name,
+            )  # fmt: skip
+        except (ValueError, TypeError) as error:
+            raise SceneError(f"{label}: {where}: {error}") from error
+    if spec.q is not None:
+        art.q = spec.q
+    if spec.qd is not None:
+        art.qd = spec.qd
+    return art
+
+
 def build_world(scene: schema.Scene, base: Path, label: str) -> World:
     """The world a validated scene describes; ``base`` is the directory mesh paths are relative to."""
     settings = scene.world
@@ -145,6 +172,15 @@ def build_world(scene: schema.Scene, base: Path, label: str) -> World:
                 raise SceneError(f"{label}: {place}: {error}") from error
             if item.name is not None:
                 named[item.name] = body
+    for k, spec in enumerate(scene.articulations):
+        place = f"articulations[{k}]"
+        try:
+            copy = world.add_articulation(_articulation(spec, world.gravity, base, place, label))
+        except SceneError:
+            raise
+        except (ValueError, TypeError) as error:
+            raise SceneError(f"{label}: {place}: {error}") from error
+        named.update({body.name: body for body in copy.bodies})
     for k, spec in enumerate(scene.joints):
         place = f"joints[{k}]"
         try:

@@ -219,6 +219,48 @@ class DistanceJoint(_Joint):
 Joint = Annotated[BallJoint | HingeJoint | SliderJoint | FixedJoint | DistanceJoint, Field(discriminator="type")]
 
 
+# --- articulations -------------------------------------------------------------------------------------
+
+
+class LinkJoint(_Strict):
+    type: Literal["revolute", "prismatic", "ball", "free", "fixed"]
+    axis: Vector3 | None = None
+
+    @model_validator(mode="after")
+    def _axis(self):
+        if (self.type in ("revolute", "prismatic")) != (self.axis is not None):
+            raise ValueError("revolute and prismatic joints need an axis, the others take none")
+        return self
+
+
+class Link(_Strict):
+    """One link: its joint to ``parent`` (a link name; omitted: the base), its frame in the parent's frame at
+    zero displacement, its geometry and mass in its own frame."""
+
+    name: str = Field(min_length=1)
+    joint: LinkJoint
+    parent: str | None = None
+    position: Vector3 = (0.0, 0.0, 0.0)
+    orientation: Quaternion = (1.0, 0.0, 0.0, 0.0)
+    shape: Shape | None = None
+    shape_position: Vector3 = (0.0, 0.0, 0.0)
+    shape_orientation: Quaternion = (1.0, 0.0, 0.0, 0.0)
+    mass: Positive | None = None
+    density: Positive | None = None
+
+
+class Articulation(_Strict):
+    """A tree of links (``tumble.Articulation``) put into the world at its coordinates ``q``, ``qd``: its links
+    become bodies named ``NAME/LINK``, its joints world joints (``World.add_articulation``)."""
+
+    name: str = Field(min_length=1)
+    base_position: Vector3 = (0.0, 0.0, 0.0)
+    base_orientation: Quaternion = (1.0, 0.0, 0.0, 0.0)
+    links: list[Link] = Field(min_length=1)
+    q: list[Finite] | None = None
+    qd: list[Finite] | None = None
+
+
 # --- the whole file ---------------------------------------------------------------------------------
 
 
@@ -250,4 +292,5 @@ class Scene(_Strict):
     bodies: list[Body] = []
     static: list[Static] = []
     joints: list[Joint] = []
+    articulations: list[Articulation] = []
     recording: Recording = Recording()
