@@ -15,8 +15,10 @@ $(STAMP): pyproject.toml
 
 install: $(STAMP)
 
+# The flagship scene (a mixed pile poured into a bowl while a wrecking ball swings through it): writes the
+# trajectory, out/replay.html (open it in a browser) and out/energy.png.
 demo: $(STAMP)
-	$(PY) examples/basic/dzhanibekov.py
+	$(PY) -m tumble run flagship --out out/flagship.h5 --html out/replay.html --plot out/energy.png
 
 # The browser tests drive Debian's Chromium through Playwright (no browser download).
 $(BROWSER_STAMP): $(STAMP)

@@ -1,0 +1,10 @@
+"""``python -m tumble``: the ``tumble`` command (see :mod:`tumble.cli`)."""
+
+from __future__ import annotations
+
+import sys
+
+from .cli import main
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,324 @@
+"""The ``tumble`` command, run as a user runs it: ``python -m tumble ...`` in a subprocess (docs/cli.md).
+
+Each subprocess pays for ``import tumble`` and for loading the compiled kernels from Numba's disk cache (about a
+second when warm), so the runs are short and shared between tests through module fixtures.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import re
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+import tumble
+from tumble import scene_file
+from tumble.trajectory import Trajectory
+from tumble.viewer.page import read_page_data
+
+REPO = Path(__file__).resolve().parents[1]
+
+SMALL_SCENE = """\
+description = "Three shapes on the ground and a hinged pendulum (the CLI tests' scene)."
+
+[world]
+dt = 0.016666666666666666
+duration = 2.0
+
+[[static]]
+name = "ground"
+shape = { type = "plane" }
+
+[[bodies]]
+name = "ball"
+shape = { type = "sphere", radius = 0.1 }
+density = 1000.0
+position = [0.0, 0.0, 1.0]
+
+[[bodies]]
+name = "crate"
+shape = { type = "box", extents = [0.2, 0.3, 0.4] }
+density = 500.0
+position = [0.5, 0.0, 1.0]
+
+[[bodies]]
+name = "bob"
+shape = { type = "capsule", radius = 0.05, length = 0.2 }
+mass = 1.0
+position = [2.0, 0.0, 2.0]
+
+[[joints]]
+type = "hinge"
+a = "bob"
+anchor = [1.5, 0.0, 2.0]
+axis = [0.0, 1.0, 0.0]
+"""
+
+# A box spun at 1e150 rad/s: it falls for 25 steps, and the step in which it lands overflows.
+SPINNER_SCENE = """\
+[world]
+duration = 2.0
+
+[[static]]
+name = "ground"
+shape = { type = "plane" }
+
+[[bodies]]
+name = "spinner"
+shape = { type = "box", extents = [0.2, 0.2, 0.2] }
+density = 1000.0
+position = [0.0, 0.0, 1.0]
+angular_velocity = [1e150, 0.0, 0.0]
+"""
+
+
+def tumble_cli(*args, cwd=None, timeout=300, env=None) -> subprocess.CompletedProcess:
+    """``python -m tumble ARGS`` in a fresh process; stdout and stderr as text."""
+    environment = {k: v for k, v in os.environ.items() if k not in ("FORCE_COLOR", "COLUMNS")}
+    environment.update(env or {})
+    return subprocess.run(
+        [sys.executable, "-m", "tumble", *map(str, args)],
+        capture_output=True,
+        text=True,
+        cwd=cwd,
+        timeout=timeout,
+        env=environment,
+    )
+
+
+def assert_clean_failure(result, status: int, *fragments: str) -> None:
+    """Exit status ``status``, each fragment in stderr, and no traceback."""
+    assert result.returncode == status, (result.returncode, result.stdout, result.stderr)
+    assert "Traceback" not in result.stderr, result.stderr
+    for fragment in fragments:
+        assert fragment in result.stderr, (fragment, result.stderr)
+
+
+@pytest.fixture(scope="module")
+def folder(tmp_path_factory) -> Path:
+    path = tmp_path_factory.mktemp("cli")
+    (path / "small.toml").write_text(SMALL_SCENE)
+    (path / "spinner.toml").write_text(SPINNER_SCENE)
+    return path
+
+
+@pytest.fixture(scope="module")
+def flagship_run(folder) -> dict:
+    """The shipped flagship scene run for 0.5 s with every output."""
+    out = {"h5": folder / "run" / "flagship.h5", "html": folder / "run" / "replay.html", "png": folder / "energy.png"}
+    result = tumble_cli("run", "flagship", "--duration", "0.5", "--out", out["h5"], "--html", out["html"],
+                        "--plot", out["png"], "--quiet")  # fmt: skip
+    return {"result": result, **out}
+
+
+def test_version():
+    result = tumble_cli("--version")
+    assert result.returncode == 0
+    assert result.stdout.startswith(f"tumble {tumble.__version__} ")
+
+
+def test_run_writes_trajectory_replay_and_plot(flagship_run):
+    result = flagship_run["result"]
+    assert result.returncode == 0, result.stderr
+    assert "Traceback" not in result.stderr
+    for row in ("simulated time", "steps", "steps/s", "real-time factor", "energy drift", "contacts", "sleeping"):
+        assert row in result.stdout, result.stdout
+    assert "30 " in result.stdout  # 0.5 s at dt = 1/60
+
+    trajectory = Trajectory.load(flagship_run["h5"])
+    assert len(trajectory) == 31 and trajectory.time[-1] == pytest.approx(0.5)
+    assert trajectory.metadata["status"] == "complete"
+    scene = trajectory.metadata["scene"]
+    assert scene["file"] == "flagship.toml" and "wrecking_ball" in json.dumps(scene["source"])
+    assert "wrecking_ball" in trajectory.body_names
+
+    data = read_page_data(flagship_run["html"].read_text(encoding="utf-8"))
+    assert data["bodyCount"] == trajectory.body_count and data["frameCount"] == 31
+    assert {"mesh", "hull", "sphere", "box", "capsule", "cylinder"} <= {s["kind"] for s in data["shapes"]}
+    assert flagship_run["png"].read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_view_rebuilds_the_shapes_from_the_recorded_scene(flagship_run, folder):
+    page = folder / "view" / "replay.html"
+    result = tumble_cli("view", flagship_run["h5"], "-o", page, "--max-frames", "10")
+    assert result.returncode == 0, result.stderr
+    assert "balls" not in result.stderr  # the shapes came from the scene stored in the file
+    data = read_page_data(page.read_text(encoding="utf-8"))
+    assert data["frameCount"] == 10 and "mesh" in {s["kind"] for s in data["shapes"]}
+
+    # Another scene's shapes do not fit: bad input, said in one line.
+    result = tumble_cli("view", flagship_run["h5"], "-o", page, "--scene", folder / "small.toml")
+    assert_clean_failure(result, 2, "small.toml has 4 bodies but the trajectory has 103")
+
+
+def test_view_without_a_scene_draws_balls(folder):
+    world = scene_file.load(folder / "small.toml").world
+    world.simulate(0.1, 1 / 60).save(folder / "plain.npz")  # no scene in its metadata
+    page = folder / "plain.html"
+    result = tumble_cli("view", folder / "plain.npz", "-o", page)
+    assert result.returncode == 0, result.stderr
+    assert "drawn as balls" in result.stderr and "--scene" in result.stderr
+    assert {s["kind"] for s in read_page_data(page.read_text(encoding="utf-8"))["shapes"]} == {"sphere"}
+    result = tumble_cli("view", folder / "plain.npz", "-o", page, "--scene", folder / "small.toml")
+    assert result.returncode == 0, result.stderr
+    data = read_page_data(page.read_text(encoding="utf-8"))
+    assert {s["kind"] for s in data["shapes"]} == {"sphere", "box", "capsule"} and len(data["planes"]) == 1
+
+
+def test_plot(flagship_run, folder):
+    out = folder / "plots"
+    result = tumble_cli("plot", flagship_run["h5"], "--what", "energy,momentum,omega,paths", "-o", out,
+                        "--bodies", "wrecking_ball,link9")  # fmt: skip
+    assert result.returncode == 0, result.stderr
+    for what in ("energy", "momentum", "omega", "paths"):
+        assert (out / f"flagship_{what}.png").read_bytes()[:4] == b"\x89PNG"
+    single = folder / "one.svg"
+    assert tumble_cli("plot", flagship_run["h5"], "-o", single).returncode == 0
+    assert single.read_text().lstrip().startswith("<?xml")
+
+    assert_clean_failure(tumble_cli("plot", flagship_run["h5"], "--what", "energy,spin"), 2, "--what")
+    assert_clean_failure(tumble_cli("plot", flagship_run["h5"], "--what", "omega", "--bodies", "nobody", "-o", out),
+                         2, "nobody")  # fmt: skip
+
+
+def test_info_lists_bodies_joints_and_settings(folder):
+    result = tumble_cli("info", folder / "small.toml")
+    assert result.returncode == 0, result.stderr
+    out = result.stdout
+    for text in ("Three shapes on the ground", "ground", "static", "ball", "crate", "bob", "dynamic", "hinge",
+                 "world", "integrator", "substeps", "0.0166667"):  # fmt: skip
+        assert text in out, (text, out)
+    # The crate: 0.2 x 0.3 x 0.4 m of 500 kg/m³ = 12 kg; principal moments m (b² + c²) / 12 ascending.
+    crate = next(line for line in out.splitlines() if " crate " in line)
+    assert " 12 " in crate and "(0.13, 0.2, 0.25)" in crate
+    assert re.search(r"[+-]z, [+-]y, [+-]x", crate), crate  # the principal axes of those moments: z, y, x
+
+
+def test_examples_lists_and_copies(tmp_path):
+    result = tumble_cli("examples")
+    assert result.returncode == 0, result.stderr
+    shipped = scene_file.shipped()
+    assert any(p.name == "flagship.toml" for p in shipped)
+    for path in shipped:
+        assert path.name in result.stdout
+    assert "wrecking ball" in result.stdout
+
+    result = tumble_cli("examples", "--copy", tmp_path / "scenes")
+    assert result.returncode == 0, result.stderr
+    assert sorted(p.name for p in (tmp_path / "scenes").glob("*.toml")) == sorted(p.name for p in shipped)
+    assert len(scene_file.load(tmp_path / "scenes" / "flagship.toml").world.bodies) == 103
+    again = tumble_cli("examples", "--copy", tmp_path / "scenes")  # existing files are kept unless --force
+    assert again.returncode == 0 and "kept existing" in again.stderr
+
+
+BAD_SCENES = {
+    # name: (file text, what stderr must name besides the file)
+    "syntax": ('[world]\ndt = 0.01\n[[bodies]\nname = "x"\n', "line 3"),
+    "wrong_type": (
+        '[[bodies]]\nname = "x"\nshape = { type = "sphere", radius = "big" }\nmass = 1.0\n',
+        "bodies[0].shape.radius",
+    ),  # fmt: skip
+    "unknown_key": (
+        '[[bodies]]\nname = "x"\nshape = { type = "sphere", radius = 0.1 }\nmass = 1.0\ncolour = "red"\n',
+        "bodies[0].colour",
+    ),  # fmt: skip
+    "negative_mass": (
+        '[[bodies]]\nname = "x"\nshape = { type = "sphere", radius = 0.1 }\nmass = -1.0\n',
+        "bodies[0].mass",
+    ),  # fmt: skip
+    "missing_mesh": (
+        '[[static]]\nname = "rock"\nshape = { type = "mesh", path = "meshes/rock.stl" }\n',
+        "static[0].shape.path",
+    ),  # fmt: skip
+}
+
+
+@pytest.mark.parametrize("case", sorted(BAD_SCENES))
+def test_bad_scene_is_exit_2_with_file_and_place(case, tmp_path):
+    text, place = BAD_SCENES[case]
+    path = tmp_path / f"{case}.toml"
+    path.write_text(text)
+    command = "info" if case in ("syntax", "unknown_key") else "run"
+    assert_clean_failure(tumble_cli(command, path, "--quiet") if command == "run" else tumble_cli(command, path),
+                         2, f"{case}.toml", place)  # fmt: skip
+
+
+def test_bad_arguments_are_exit_2(folder, tmp_path):
+    assert_clean_failure(tumble_cli("run", tmp_path / "nowhere.toml"), 2, "nowhere.toml", "no such scene file")
+    assert_clean_failure(tumble_cli("run", folder / "small.toml", "--dt", "-1"), 2, "--dt", "-1")
+    assert_clean_failure(tumble_cli("run", folder / "small.toml", "--out", tmp_path / "x.csv"), 2, ".h5", ".npz")
+    assert_clean_failure(tumble_cli("run", folder / "small.toml", "--plot", tmp_path / "e.xyz"), 2, "--plot")
+    assert_clean_failure(tumble_cli("view", tmp_path / "none.h5", "-o", tmp_path / "r.html"), 2, "none.h5")
+    assert_clean_failure(tumble_cli("frobnicate"), 2, "invalid choice")
+    assert not list(tmp_path.iterdir())  # nothing was written
+    (folder / "garbage.npz").write_bytes(b"PK\x03\x04 not a zip")
+    assert_clean_failure(tumble_cli("plot", folder / "garbage.npz"), 2, "garbage.npz", "cannot read")
+
+
+def test_simulation_error_is_exit_1_and_keeps_what_was_recorded(folder):
+    out, page, png = folder / "fail" / "spin.h5", folder / "fail" / "spin.html", folder / "fail" / "spin.png"
+    result = tumble_cli("run", folder / "spinner.toml", "--out", out, "--html", page, "--plot", png, "--quiet")
+    assert_clean_failure(result, 1, "simulation failed", "'spinner'", "step 25")
+    assert "FAILED" in result.stdout
+    trajectory = Trajectory.load(out)  # the steps before the failing one, in a readable file
+    assert len(trajectory) == 26 and trajectory.metadata["status"] == "failed"
+    assert "spinner" in trajectory.metadata["error"]
+    assert read_page_data(page.read_text(encoding="utf-8"))["frameCount"] == 26
+    assert png.stat().st_size > 1000
+
+
+def test_progress_bar_through_the_recorder_callback(folder, tmp_path):
+    result = tumble_cli("run", folder / "small.toml", "--duration", "1.0", "--out", tmp_path / "s.npz",
+                        env={"FORCE_COLOR": "1", "COLUMNS": "120"})  # fmt: skip
+    assert result.returncode == 0, result.stderr
+    assert "simulating" in result.stderr  # the bar was drawn
+    trajectory = Trajectory.load(tmp_path / "s.npz")
+    assert len(trajectory) == 61 and trajectory.metadata["status"] == "complete"
+
+
+@pytest.mark.skipif(not hasattr(signal, "SIGINT") or sys.platform == "win32", reason="needs POSIX SIGINT")
+def test_sigint_stops_the_run_and_keeps_the_file_readable(folder):
+    out = folder / "interrupted.h5"
+    command = [sys.executable, "-m", "tumble", "run", str(folder / "small.toml"), "--out", str(out),
+               "--dt", "1e-4", "--duration", "1000", "--quiet"]  # fmt: skip
+    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        deadline = time.monotonic() + 300  # a cold Numba cache compiles first
+        while not out.exists() and time.monotonic() < deadline and process.poll() is None:
+            time.sleep(0.05)
+        start = out.stat().st_size
+        while out.stat().st_size == start and time.monotonic() < deadline and process.poll() is None:
+            time.sleep(0.05)  # the file grows when the first chunk is written
+        process.send_signal(signal.SIGINT)
+        stdout, stderr = process.communicate(timeout=60)
+    finally:
+        if process.poll() is None:
+            process.kill()
+    assert process.returncode == 130, (stdout, stderr)
+    assert "interrupted" in stderr and "Traceback" not in stderr
+    trajectory = Trajectory.load(out)
+    assert trajectory.metadata["status"] == "interrupted"
+    assert 1 < len(trajectory) and trajectory.time[-1] < 1000
+
+
+def test_bench_reaches_the_repository_benchmarks():
+    # An unknown benchmark name is refused by benchmarks/run.py itself: proof that it was found and imported.
+    result = tumble_cli("bench", "--only", "no_such_benchmark", cwd=REPO)
+    assert result.returncode == 2
+    assert "no_such_benchmark" in result.stderr and "Traceback" not in result.stderr
+
+
+def test_main_in_process_and_bench_outside_a_checkout(monkeypatch, capsys):
+    from tumble import cli
+
+    monkeypatch.setattr(cli, "_find_benchmarks", lambda: None)
+    assert cli.main(["bench", "--quick"]) == 2
+    assert "benchmarks live in the repository" in capsys.readouterr().err
+    assert cli.main([]) == 2  # no command: the help, and the status of bad input
+    assert "COMMAND" in capsys.readouterr().out
