@@ -91,8 +91,11 @@ def _contact_steps(model, state, inputs, params, scratch, h, n_steps, recording,
     for step in range(n_steps):
         before = state.copy()
         loads = inputs if step == 0 else zero  # applied loads act during the first step only
-        contact_step(model, state, loads, params, scratch, h)
-        bad = _first_non_finite_body(state, model.body_is_dynamic)
+        try:
+            contact_step(model, state, loads, params, scratch, h)
+            bad = _first_non_finite_body(state, model.body_is_dynamic, before)
+        except (ZeroDivisionError, FloatingPointError):  # a kernel divided by an overflowed value
+            bad = _fastest_body(before, model.body_is_dynamic)
         if bad >= 0:
             state.assign(before)
             return step, bad
@@ -106,14 +109,29 @@ def _contact_steps(model, state, inputs, params, scratch, h, n_steps, recording,
     return n_steps, -1
 
 
-def _first_non_finite_body(state: State, is_dynamic: np.ndarray) -> int:
-    """The first body with a non-finite value, dynamic bodies first (a static one only turns NaN through them)."""
+def _first_non_finite_body(state: State, is_dynamic: np.ndarray, before: State | None = None) -> int:
+    """The body with a non-finite value, dynamic bodies first (a static one only turns NaN through them); when
+    several turned non-finite in the same step (one hit the other), the one that was fastest before it."""
     finite = np.isfinite(state.body_pos).all(axis=1) & np.isfinite(state.body_quat).all(axis=1)
     finite &= np.isfinite(state.body_linvel).all(axis=1) & np.isfinite(state.body_angmom).all(axis=1)
     bad = np.flatnonzero(~finite & is_dynamic)
     if bad.size == 0:
         bad = np.flatnonzero(~finite)
+    if bad.size > 1 and before is not None:
+        return int(bad[np.argmax(_motion(before)[bad])])
     return int(bad[0]) if bad.size else -1
+
+
+def _motion(state: State) -> np.ndarray:
+    """|v| + |L| per body (non-finite counts as infinite): a rough measure of which body runs away."""
+    with np.errstate(over="ignore", invalid="ignore"):
+        size = np.linalg.norm(state.body_linvel, axis=1) + np.linalg.norm(state.body_angmom, axis=1)
+    return np.where(np.isfinite(size), size, np.inf)
+
+
+def _fastest_body(state: State, is_dynamic: np.ndarray) -> int:
+    motion = np.where(is_dynamic, _motion(state), -1.0)
+    return int(np.argmax(motion)) if motion.size else -1
 
 
 def contact_step(model: Model, state: State, inputs: Inputs, params: Params, scratch: Scratch, dt: float) -> None:

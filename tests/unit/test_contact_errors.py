@@ -323,3 +323,17 @@ def test_a_force_whose_moment_overflows_is_refused():
     with pytest.raises(ValueError, match="has a moment about the centre of mass that overflows"):
         body.apply_force((1e300, 0.0, 0.0), point=(0.0, 1e300, 0.0))
     assert not world.inputs.body_torque.any()
+
+
+@pytest.mark.parametrize(("spin", "step"), [(1e160, 0), (1e100, 25)])
+def test_a_runaway_body_is_named_even_when_it_takes_another_with_it(spin, step):
+    """1e160 rad/s overflows inside a kernel (a division by an infinite value); 1e100 rad/s lands on the ground
+    beside a calm box in the same step, and both turn NaN: the error names the spinner either way."""
+    world = tumble.World()
+    world.add_static(tumble.Plane(), name="ground")
+    world.add_body(tumble.Box((0.2, 0.2, 0.2)), mass=1.0, position=(0, 0, 1), name="calm")
+    world.add_body(tumble.Box((0.2, 0.2, 0.2)), mass=1.0, position=(1, 0, 1), angular_velocity=(spin, 0, 0),
+                   name="spinner")  # fmt: skip
+    with np.errstate(all="ignore"), pytest.raises(tumble.SimulationError, match=f"body 'spinner' .* in step {step} "):
+        world.simulate(2.0, 1 / 60)
+    assert np.isfinite(world.state.body_pos).all()

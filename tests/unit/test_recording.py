@@ -91,8 +91,8 @@ def test_a_failed_run_leaves_every_frame_before_the_failing_step(tmp_path, monke
     chunk are in the file, which is closed with status "failed"; the error carries the same frames."""
     checked = pipeline._first_non_finite_body
 
-    def fail_at_step_23(state, is_dynamic):
-        return 3 if state.step_count == 23 else checked(state, is_dynamic)  # step_count is that before the step
+    def fail_at_step_23(state, *args):
+        return 3 if state.step_count == 23 else checked(state, *args)  # step_count is that before the step
 
     monkeypatch.setattr(pipeline, "_first_non_finite_body", fail_at_step_23)
     path = tmp_path / "failed.h5"
