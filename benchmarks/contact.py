@@ -131,15 +131,9 @@ def _boxes(world: tumble.World) -> _Boxes:
 
 
 @dataclass
-class _Sim:
-    """A built scene in one engine: ``step()`` advances one step of ``1 / hz``, ``state()`` reads the boxes."""
+class _Sim(peers.EngineRun):
+    """A built scene: ``state()`` reads the boxes, ``penetration()`` the engine's deepest contact."""
 
-    engine: str
-    config: str
-    hz: int
-    threads: int
-    build_s: float
-    step: Callable[[], None]
     state: Callable[[], tuple[np.ndarray, np.ndarray, np.ndarray]]  # position, quat [w, x, y, z], velocity
     penetration: Callable[[], float]  # [m], the engine's deepest contact now
     extra: Callable[[], dict] = field(default=dict)

@@ -261,15 +261,9 @@ def _outcome_columns(outcome: _Outcome) -> dict:
 
 
 @dataclass
-class _Sim:
-    """A built chain in one engine: ``step()`` advances one step of ``1 / hz``, ``frame()`` reads the links."""
+class _Sim(peers.EngineRun):
+    """A built chain: ``frame()`` reads the links."""
 
-    engine: str
-    config: str
-    hz: int
-    threads: int
-    build_s: float
-    step: Callable[[], None]
     frame: Callable[[], _Frame]
     close: Callable[[], None] = field(default=lambda: None)
     failed: Callable[[], str] = field(default=str)  # why the engine gave up, "" while it runs

@@ -10,9 +10,13 @@ angular velocity in the BODY (local) frame. At the identity orientation local an
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from dataclasses import dataclass
+
 import numpy as np
 
 __all__ = [
+    "EngineRun",
     "angular_momentum_world",
     "box_vertices_min_z",
     "boxes_on_plane_mjcf",
@@ -33,6 +37,19 @@ __all__ = [
 ]
 
 MUJOCO_INTEGRATORS = ("Euler", "RK4", "implicit", "implicitfast")
+
+
+@dataclass
+class EngineRun:
+    """A scene built in one engine and configuration: ``step()`` advances one step of ``1 / hz``. Each
+    benchmark adds how it reads the scene back."""
+
+    engine: str
+    config: str
+    hz: int
+    threads: int
+    build_s: float
+    step: Callable[[], None]
 
 
 def have_mujoco() -> bool:
