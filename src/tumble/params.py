@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from enum import IntEnum
 
@@ -34,7 +35,9 @@ INTEGRATOR_NAMES = {
 # 8 mm in 10 s) and the 1000-cube pile penetrates 1.8 mm. 120 Hz (the cap at 8 substeps) sags 3x less but lets
 # thin cards slide apart (docs/contact.md).
 # Push-out at most 3 m/s, no bounce below 1 m/s, 2 cm speculative margin; islands sleep after 0.5 s below
-# 5 cm/s and 0.05 rad/s.
+# 5 cm/s and 0.05 rad/s. Joints are as stiff as the substeps allow (a quarter of the substep rate: 120 Hz at
+# 60 Hz): a soft joint is a spring that soaks up a chain's energy when it snaps taut (a 5-link chain released
+# horizontal kept 99 % of it at 1200 Hz, 50 % at 120 Hz, stepping at 600 Hz), damping ratio 2.
 DEFAULT_SOLVER = SolverSettings(
     substeps=8,
     contact_hertz=60.0,
@@ -46,7 +49,7 @@ DEFAULT_SOLVER = SolverSettings(
     sleep_linear=0.05,
     sleep_angular=0.05,
     time_to_sleep=0.5,
-    joint_hertz=120.0,
+    joint_hertz=math.inf,
     joint_damping_ratio=2.0,
 )
 

@@ -412,8 +412,9 @@ class World:
         """Change contact solver settings by name: ``substeps`` (int >= 1), ``contact_hertz`` (> 0),
         ``contact_damping_ratio`` (>= 0), ``contact_push_max`` [m/s] (> 0), ``restitution_threshold`` [m/s] (>= 0),
         ``speculative_distance`` [m] (>= 0), ``sleep`` (bool), ``sleep_linear`` [m/s], ``sleep_angular`` [rad/s],
-        ``time_to_sleep`` [s] (all >= 0), ``joint_hertz`` (> 0) and ``joint_damping_ratio`` (>= 0), the stiffness of
-        the joints' position correction."""
+        ``time_to_sleep`` [s] (all >= 0), ``joint_hertz`` (> 0; capped at a quarter of the substep rate, and the
+        default ``inf`` means that cap: 120 Hz at 60 Hz with 8 substeps) and ``joint_damping_ratio`` (>= 0), the
+        stiffness of the joints' position correction."""
         current = self._params.solver._asdict()
         for key, value in settings.items():
             if key not in current:
@@ -428,6 +429,8 @@ class World:
                 if not isinstance(value, (bool, np.bool_)):
                     raise TypeError(f"sleep must be True or False, got {value!r}")
                 current[key] = bool(value)
+            elif key == "joint_hertz" and value == math.inf:
+                current[key] = math.inf  # as stiff as the substeps allow (the default)
             else:
                 positive = key in ("contact_hertz", "contact_push_max", "joint_hertz")
                 current[key] = as_float(key, value, positive=positive, nonnegative=not positive)

@@ -10,6 +10,7 @@ import pytest
 from scipy.special import ellipk
 
 import tumble
+import tumble.scenes
 
 G = 9.81
 DT = 1 / 60
@@ -317,3 +318,17 @@ def test_ball_joint_cone_and_twist_limits_hold():
     assert min(twists) > -0.5 - 1e-3
     assert twists[-1] == pytest.approx(-0.5, abs=2e-3)
     assert wrist.swing < 1e-6
+
+
+def test_stiff_joints_keep_a_whipping_chain_s_energy():
+    """A 2-link chain released horizontal snaps taut as it swings: at 600 Hz the default joints (as stiff as the
+    substeps allow, 1200 Hz) keep its energy within 1 %; 120 Hz joints soak up 5.8 % in 3 s (measured)."""
+    drop = 0.1 * 9.81 * (0.05 + 0.15)  # potential released from horizontal to hanging
+    losses = {}
+    for hertz in (math.inf, 120.0):
+        world = tumble.scenes.pendulum_chain(2, joint_hertz=hertz)
+        energy = world.total_energy()
+        world.simulate(3.0, 1 / 600)
+        losses[hertz] = (energy - world.total_energy()) / drop
+    assert abs(losses[math.inf]) < 0.01
+    assert losses[120.0] > 0.03

@@ -99,3 +99,12 @@ def test_ball_joint_limits_need_an_axis_and_sane_angles(world):
     joint = world.add_joint(tumble.HingeJoint(a, None, (0, 0, 0), (0, 0, 1)))
     with pytest.raises(AttributeError, match="a hinge joint has no such coordinate"):
         _ = joint.swing
+
+
+def test_joints_default_to_the_stiffest_the_substeps_allow():
+    assert tumble.World().solver.joint_hertz == math.inf
+    world = tumble.World(joint_hertz=math.inf)
+    world.set_solver(joint_hertz=240.0)
+    assert world.solver.joint_hertz == 240.0
+    with pytest.raises(ValueError, match="joint_hertz must be finite"):
+        world.set_solver(joint_hertz=math.nan)

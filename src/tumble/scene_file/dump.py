@@ -141,10 +141,11 @@ def world_to_scene(world, *, dt: float | None = None, duration: float | None = N
         "substeps": int(solver.substeps),
         "contact_hertz": float(solver.contact_hertz),
         "contact_damping_ratio": float(solver.contact_damping_ratio),
-        "joint_hertz": float(solver.joint_hertz),
         "joint_damping_ratio": float(solver.joint_damping_ratio),
         "sleep": bool(solver.sleep),
     }
+    if math.isfinite(solver.joint_hertz):  # else the default: as stiff as the substeps allow
+        settings["joint_hertz"] = float(solver.joint_hertz)
     if dt is not None:
         settings["dt"] = float(dt)
     if duration is not None:

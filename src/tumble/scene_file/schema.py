@@ -272,7 +272,7 @@ class WorldSettings(_Strict):
     substeps: Annotated[int, Field(ge=1, le=1000)] | None = None
     contact_hertz: Positive | None = None
     contact_damping_ratio: NonNegative | None = None
-    joint_hertz: Positive | None = None
+    joint_hertz: Annotated[float, Field(gt=0.0)] | None = None  # inf: as stiff as the substeps allow
     joint_damping_ratio: NonNegative | None = None
     sleep: bool | None = None
 
