@@ -9,6 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from ._validate import as_quaternion, as_vector3
+from .dynamics.joint_solver import LOWER, MAX_MOTOR, MOTOR_SPEED, TARGET, UPPER
 from .rotation import quat_rotate, quat_to_matrix
 
 __all__ = ["Body", "Joint"]
@@ -313,10 +314,10 @@ class Joint:
 
         world = self._world
         model, state = world.model, world.state
-        out = np.zeros((model.joint_count, 5))
+        out = np.zeros((1, 5))
         joint_coordinates(model.joints, state.body_pos, state.body_quat, state.body_linvel,
-                          world.angular_velocities(), out)  # fmt: skip
-        return out[self._index]
+                          world.angular_velocities(), self._index, self._index + 1, out)  # fmt: skip
+        return out[0]
 
     def _require(self, *kinds: str) -> None:
         if self.kind not in kinds:
@@ -372,7 +373,7 @@ class Joint:
         if self.kind == "slider":
             return float(np.sqrt(max(gap**2 - value**2, 0.0)))
         if self.kind == "distance":
-            lower, upper = self._spec().drive[:2]
+            lower, upper = self._spec().drive[[LOWER, UPPER]]
             return float(max(lower - value, value - upper, 0.0))
         return float(gap)
 
@@ -420,40 +421,40 @@ class Joint:
     @property
     def motor_speed(self) -> float:
         """Hinge [rad/s] or slider [m/s]: the motor's target speed (settable)."""
-        return float(self._spec().drive[2])
+        return float(self._spec().drive[MOTOR_SPEED])
 
     @motor_speed.setter
     def motor_speed(self, value) -> None:
-        self._set_drive(2, "motor_speed", value, ("hinge", "slider"))
+        self._set_drive(MOTOR_SPEED, "motor_speed", value, ("hinge", "slider"))
 
     @property
     def max_motor_torque(self) -> float:
         """Hinge: the motor's largest torque [N m] (settable; 0 turns the motor off)."""
         self._require("hinge")
-        return float(self._spec().drive[3])
+        return float(self._spec().drive[MAX_MOTOR])
 
     @max_motor_torque.setter
     def max_motor_torque(self, value) -> None:
-        self._set_drive(3, "max_motor_torque", value, ("hinge",), nonnegative=True)
+        self._set_drive(MAX_MOTOR, "max_motor_torque", value, ("hinge",), nonnegative=True)
 
     @property
     def max_motor_force(self) -> float:
         """Slider: the motor's largest force [N] (settable; 0 turns the motor off)."""
         self._require("slider")
-        return float(self._spec().drive[3])
+        return float(self._spec().drive[MAX_MOTOR])
 
     @max_motor_force.setter
     def max_motor_force(self, value) -> None:
-        self._set_drive(3, "max_motor_force", value, ("slider",), nonnegative=True)
+        self._set_drive(MAX_MOTOR, "max_motor_force", value, ("slider",), nonnegative=True)
 
     @property
     def spring_target(self) -> float:
         """Hinge [rad] or slider [m]: where the spring pulls (settable)."""
-        return float(self._spec().drive[6])
+        return float(self._spec().drive[TARGET])
 
     @spring_target.setter
     def spring_target(self, value) -> None:
-        self._set_drive(6, "spring_target", value, ("hinge", "slider"))
+        self._set_drive(TARGET, "spring_target", value, ("hinge", "slider"))
 
     def __eq__(self, other) -> bool:
         return isinstance(other, Joint) and other._world is self._world and other._index == self._index

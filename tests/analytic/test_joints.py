@@ -48,8 +48,9 @@ def test_pendulum_released_at_90_degrees_has_the_elliptic_period(joint):
     crossings = _crossings(times, xs)
     measured = 2 * np.diff(crossings)
     assert len(measured) >= 5
-    np.testing.assert_allclose(measured, period, rtol=2e-3)  # issue: within 1 % at 60 Hz
-    assert handle.position_error < 1e-3
+    # Measured 1.1e-4 (hinge, ball) and 9.7e-5 (rod), anchors 0.19 mm apart at worst; the issue asks for 1 %.
+    np.testing.assert_allclose(measured, period, rtol=5e-4)
+    assert handle.position_error < 5e-4
 
 
 def test_hanging_pendulum_reaction_is_its_weight_and_hinge_holds_a_torque():
@@ -82,7 +83,8 @@ def test_slider_on_an_incline_accelerates_at_g_sin_theta():
     for _ in range(60):
         world.step(DT)
     expected = 0.5 * G * math.sin(theta) * world.time**2
-    assert slider.translation == pytest.approx(expected, rel=2e-2)
+    # semi-implicit Euler over n = 480 substeps overshoots ½ a t² by the factor (n + 1) / n (measured 2.1e-3)
+    assert slider.translation == pytest.approx(expected * 481 / 480, rel=1e-6)
     assert slider.speed == pytest.approx(G * math.sin(theta) * world.time, rel=1e-6)
     assert slider.position_error < 1e-4 and slider.angular_error < 1e-9  # soft: g cos θ / (2π 120 Hz)² = 1.5e-5 m
 

@@ -512,10 +512,11 @@ def solve_joints(joints, impulses, inv_mass, inv_inertia_world, pos, quat, linve
 
 
 @kernel
-def joint_coordinates(joints, pos, quat, linvel, angvel, out):
-    """Per joint: the drive coordinate (hinge angle or ball twist, slider translation, distance), its rate, the
-    anchor gap ``|d|``, the axis misalignment angle [rad] and a ball joint's swing [rad]. Writes: out (J, 5)."""
-    for j in range(joints.kind.shape[0]):
+def joint_coordinates(joints, pos, quat, linvel, angvel, first, stop, out):
+    """Per joint ``first <= j < stop``: the drive coordinate (hinge angle or ball twist, slider translation,
+    distance), its rate, the anchor gap ``|d|``, the axis misalignment angle [rad] and a ball joint's swing
+    [rad]. Writes: out (stop - first, 5)."""
+    for j in range(first, stop):
         a, b, kind = joints.body_a[j], joints.body_b[j], joints.kind[j]
         xa, qa, va, wa = _load_pose(a, pos, quat, linvel, angvel)
         xb, qb, vb, wb = _load_pose(b, pos, quat, linvel, angvel)
@@ -524,15 +525,16 @@ def joint_coordinates(joints, pos, quat, linvel, angvel, out):
         arm = _arm_a(kind, ra, d)
         if kind == HINGE or kind == BALL:
             value = _hinge_angle(fa, fb)
-        out[j, 0] = value
-        out[j, 1] = _axial_rate(kind == HINGE or kind == BALL, n, arm, rb, va, wa, vb, wb)
-        out[j, 4] = _swing(fa, fb)[0] if kind == BALL else 0.0
-        out[j, 2] = math.sqrt(dot(d, d))
+        out[j - first, 0] = value
+        out[j - first, 1] = _axial_rate(kind == HINGE or kind == BALL, n, arm, rb, va, wa, vb, wb)
+        out[j - first, 4] = _swing(fa, fb)[0] if kind == BALL else 0.0
+        out[j - first, 2] = math.sqrt(dot(d, d))
         if kind == HINGE:
             na, nb = quat_rotate(fa, _EX), quat_rotate(fb, _EX)
-            out[j, 3] = math.atan2(math.sqrt(dot(cross(na, nb), cross(na, nb))), dot(na, nb))
+            out[j - first, 3] = math.atan2(math.sqrt(dot(cross(na, nb), cross(na, nb))), dot(na, nb))
         elif kind == FIXED or kind == SLIDER:
             q_err = quat_mul(fb, quat_conj(fa))
-            out[j, 3] = 2.0 * math.atan2(math.sqrt(q_err[1] ** 2 + q_err[2] ** 2 + q_err[3] ** 2), abs(q_err[0]))
+            sine = math.sqrt(q_err[1] ** 2 + q_err[2] ** 2 + q_err[3] ** 2)
+            out[j - first, 3] = 2.0 * math.atan2(sine, abs(q_err[0]))
         else:
-            out[j, 3] = 0.0
+            out[j - first, 3] = 0.0

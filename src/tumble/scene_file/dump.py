@@ -12,7 +12,7 @@ import math
 
 import numpy as np
 
-from ..rotation import quat_rotate
+from ..rotation import quat_multiply, quat_rotate
 from ..shapes import Box, Capsule, ConvexHull, Cylinder, Plane, Sphere, TriMesh
 
 __all__ = ["world_to_scene"]
@@ -103,13 +103,10 @@ def _joint(joint, names: list[str]) -> dict:
     if spec.collide_connected:
         entry["collide_connected"] = True
     anchor = _floats(joint.anchor_a)
-    frame_body = spec.body_a if spec.body_a >= 0 else -1
-    state = joint._world.state
-    frame = spec.local_frame_a if frame_body < 0 else None
-    if frame_body >= 0:
-        from ..rotation import quat_multiply
-
-        frame = quat_multiply(state.body_quat[frame_body], spec.local_frame_a)
+    # The joint frame's x axis (the hinge or slider axis, a ball joint's twist axis) in the world now.
+    frame = spec.local_frame_a
+    if spec.body_a >= 0:
+        frame = quat_multiply(joint._world.state.body_quat[spec.body_a], frame)
     axis = _floats(quat_rotate(frame, (1.0, 0.0, 0.0)))
     if joint.kind == "ball":
         entry["anchor"] = anchor
