@@ -169,16 +169,22 @@ def _mujoco_energy(model, data) -> float:
     return float(data.energy[0] + data.energy[1])
 
 
+def _mujoco_chain(integrator: str, sizes: ChainSizes):
+    """The chain in MuJoCo twice: ``(model, data)`` with energy off for timing (MuJoCo would compute it every
+    step), and ``(meter, probe)`` with it on to measure the energy of a copied state."""
+    import mujoco
+
+    xml = chain_mjcf(chain_articulation(sizes.links), integrator)
+    model, meter = mujoco.MjModel.from_xml_string(xml), mujoco.MjModel.from_xml_string(xml)
+    model.opt.enableflags &= ~int(mujoco.mjtEnableBit.mjENBL_ENERGY)
+    return model, mujoco.MjData(model), meter, mujoco.MjData(meter)
+
+
 def _mujoco_step_loop(integrator: str, sizes: ChainSizes) -> dict:
     import mujoco
 
     steps = round(sizes.seconds / DT)
-    art = chain_articulation(sizes.links)
-    model = mujoco.MjModel.from_xml_string(chain_mjcf(art, integrator))
-    # energy off while timing (MuJoCo would compute it every step); a second model with it on measures
-    model.opt.enableflags &= ~int(mujoco.mjtEnableBit.mjENBL_ENERGY)
-    meter = mujoco.MjModel.from_xml_string(chain_mjcf(art, integrator))
-    data, probe = mujoco.MjData(model), mujoco.MjData(meter)
+    model, data, meter, probe = _mujoco_chain(integrator, sizes)
     start = time.perf_counter()
     mujoco.mj_step(model, data)
     first = time.perf_counter() - start
@@ -206,11 +212,7 @@ def _mujoco_rollout(integrator: str, sizes: ChainSizes) -> dict | None:
     except ImportError:
         return None
     steps = round(sizes.seconds / DT)
-    art = chain_articulation(sizes.links)
-    model = mujoco.MjModel.from_xml_string(chain_mjcf(art, integrator))
-    model.opt.enableflags &= ~int(mujoco.mjtEnableBit.mjENBL_ENERGY)
-    meter = mujoco.MjModel.from_xml_string(chain_mjcf(art, integrator))
-    data, probe = mujoco.MjData(model), mujoco.MjData(meter)
+    model, data, meter, probe = _mujoco_chain(integrator, sizes)
     spec = mujoco.mjtState.mjSTATE_FULLPHYSICS
     initial = np.empty((1, mujoco.mj_stateSize(model, spec)))
     mujoco.mj_getState(model, data, initial[0], spec)

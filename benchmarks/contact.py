@@ -37,7 +37,6 @@ boxes.
 from __future__ import annotations
 
 import functools
-import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -238,7 +237,6 @@ def _measure(sim: _Sim, scene: _Scene, boxes: _Boxes) -> dict:
     except tumble.SimulationError as error:
         notes = f"failed at step {done + 1}: {error}"
     elapsed = time.perf_counter() - start
-    timed = done - 1
     try:
         pos, quat, vel = sim.state()
         penetration = sim.penetration()
@@ -254,17 +252,7 @@ def _measure(sim: _Sim, scene: _Scene, boxes: _Boxes) -> dict:
     row = {
         "scene": scene.name,
         "bodies": int(boxes.index.size),
-        "engine": sim.engine,
-        "hz": sim.hz,
-        "config": sim.config,
-        "threads": sim.threads,
-        "sim_s": done / sim.hz,
-        "steps": done,
-        "build_s": sim.build_s,
-        "first_step_s": first,
-        "steps_per_s": timed / elapsed if timed else math.nan,
-        "ms_per_step": 1e3 * elapsed / timed if timed else math.nan,
-        "realtime_x": timed / sim.hz / elapsed if timed else math.nan,
+        **sim.timing(done, first, elapsed),
         "max_speed": float(speed.max()),
         "settled": bool(speed.max() < SETTLED_SPEED),
         "max_penetration_mm": 1e3 * penetration,

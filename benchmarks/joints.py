@@ -529,20 +529,9 @@ def _run(make: Callable[[], _Sim], chain: Chain, seconds: float) -> dict:
         first, elapsed, done, notes = _steps(sim, outcome, max(2, round(seconds * sim.hz)))
     finally:
         sim.close()
-    timed = done - 1
     return {
         "links": chain.links,
-        "engine": sim.engine,
-        "hz": sim.hz,
-        "config": sim.config,
-        "threads": sim.threads,
-        "sim_s": done / sim.hz,
-        "steps": done,
-        "build_s": sim.build_s,
-        "first_step_s": first,
-        "steps_per_s": timed / elapsed if timed > 0 else math.nan,
-        "ms_per_step": 1e3 * elapsed / timed if timed > 0 else math.nan,
-        "realtime_x": timed / sim.hz / elapsed if timed > 0 else math.nan,
+        **sim.timing(done, first, elapsed),
         **_outcome_columns(outcome),
         "notes": notes,
     }

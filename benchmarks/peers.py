@@ -10,6 +10,7 @@ angular velocity in the BODY (local) frame. At the identity orientation local an
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -50,6 +51,25 @@ class EngineRun:
     threads: int
     build_s: float
     step: Callable[[], None]
+
+    def timing(self, done: int, first: float, elapsed: float) -> dict:
+        """The columns every benchmark row shares: ``done`` steps taken, the ``first`` one timed apart [s], and
+        ``elapsed`` [s] for the other ``done - 1``."""
+        timed = done - 1
+        rate = timed / elapsed if timed > 0 else math.nan
+        return {
+            "engine": self.engine,
+            "hz": self.hz,
+            "config": self.config,
+            "threads": self.threads,
+            "sim_s": done / self.hz,
+            "steps": done,
+            "build_s": self.build_s,
+            "first_step_s": first,
+            "steps_per_s": rate,
+            "ms_per_step": 1e3 / rate if timed > 0 else math.nan,
+            "realtime_x": rate / self.hz,
+        }
 
 
 def have_mujoco() -> bool:
