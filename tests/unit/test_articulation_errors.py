@@ -302,3 +302,14 @@ def test_free_link_starts_at_its_given_pose():
     art.add_link(Free(), position=(1, 2, 3), orientation=(0, 0, 0, 2), shape=Box((1, 1, 1)), mass=1.0)
     np.testing.assert_array_equal(art.q, [1, 2, 3, 0, 0, 0, 1])
     assert art.nq == 7 and art.nv == 6
+
+
+def test_import_tumble_loads_the_articulation_only_when_used():
+    import subprocess
+    import sys
+
+    code = (
+        "import sys, tumble; assert 'tumble.articulation' not in sys.modules; "
+        "from tumble import Revolute; assert tumble.Articulation.__module__.startswith('tumble.articulation')"
+    )
+    subprocess.run([sys.executable, "-c", code], check=True, timeout=120)
