@@ -339,6 +339,24 @@ def _held_direction(dl, da, db, rows, linear_rows, ma, ia, mb, ib, dir_l, dir_a,
 
 
 @inline
+def _has_drive(joints, j, kind):
+    """Whether joint ``j`` has a drive row to solve: a spring, a motor, a limit, or a rigid distance (a plain
+    hinge or ball joint has none, and skips the drive's setup)."""
+    if kind == FIXED:
+        return False
+    lower, upper = joints.drive[j, LOWER], joints.drive[j, UPPER]
+    limited = lower < upper and (lower > -math.inf or upper < math.inf)
+    rod = kind == DISTANCE and lower == upper
+    return (
+        limited
+        or rod
+        or joints.drive[j, SPRING_HERTZ] > 0.0
+        or joints.drive[j, MAX_MOTOR] > 0.0
+        or (kind == BALL and joints.drive[j, CONE] < math.pi)
+    )
+
+
+@inline
 def _swing(fa, fb):
     """The swing of ``b``'s joint x axis away from ``a``'s: its angle and the unit axis it turns about."""
     na, nb = quat_rotate(fa, _EX), quat_rotate(fb, _EX)
@@ -415,7 +433,7 @@ def solve_joints(joints, impulses, inv_mass, inv_inertia_world, pos, quat, linve
         # Drive along the free axis: spring, motor, limits (rod: a rigid distance), each row acting on the joint
         # *with its block held*: the row's direction minus its block response y = K⁻¹ K_B,d (a Schur complement),
         # so that a hinge limit stops a pendulum bob swinging round the pivot, not just its spin about its COM.
-        if kind != FIXED:
+        if _has_drive(joints, j, kind):
             angular = kind == HINGE or kind == BALL  # a ball joint's drive is its twist (limits only)
             n, value = _drive_axis(kind, fa, d)
             if angular:
