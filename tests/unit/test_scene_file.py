@@ -215,3 +215,15 @@ def test_an_articulation_in_a_scene_becomes_bodies_and_joints(tmp_path):
     bad += 'joint = { type = "ball", axis = [0, 1, 0] }\n'
     with pytest.raises(SceneError, match=r"articulations\[0\].links\[0\].joint: .*take none"):
         scene_file.load(_write(tmp_path, bad))
+
+
+def test_joint_aliases_build_ropes_and_springs(tmp_path):
+    text = GOOD + (
+        '[[joints]]\ntype = "rope"\na = "ball"\nanchor_a = [0, 0, 1]\nanchor_b = [0, 0, 2]\n'
+        '[[joints]]\ntype = "spring"\na = "box"\nb = "ball"\nanchor_a = [1, 0, 1]\nanchor_b = [0, 0, 1]\n'
+        "spring_hertz = 2.0\n"
+    )
+    world = scene_file.load(_write(tmp_path, text, "ropes.toml")).world
+    rope, spring = (world._builder.joints[j.index].drive for j in world.joints)
+    assert rope[0] == 0.0 and rope[1] == 1.0  # slack down to 0, taut at its length
+    assert spring[4] == 2.0 and spring[6] == 1.0  # a spring towards the length at creation
