@@ -331,3 +331,61 @@ def test_nearly_coaxial_cylinders_depth_is_frame_independent():
     qb = Rotation.from_quat([q[1], q[2], q[3], q[0]])
     along = c.support(n) @ n + qb.apply(c.support(qb.inv().apply(-n))) @ -n
     assert along == pytest.approx(-sep, abs=1e-9)  # measured 0
+
+
+# --- degenerate polytopes: EPA is total ----------------------------------------------------------------------------
+
+
+def _face_corners_simplex(g, rot, pa, qa, pb, order):
+    """Support pairs of the +z face's four corners of shape 0 (a cube hull) against a point core at ``pb``."""
+    corners = [(1, 1), (1, -1), (-1, -1), (-1, 1)]
+    sim_a = np.array([gjk.support_world(g, 0, -1, pa, qa, tuple(rot.apply([*corners[i], 1e-3]))) for i in order])
+    return sim_a, np.tile(pb, (4, 1))
+
+
+def test_epa_origin_on_a_hull_face_with_its_corners_as_the_simplex():
+    """A sphere's centre exactly on a turned cube's face (touching, zero depth), and GJK's simplex the face's four
+    corners: coplanar to round-off, so the tetrahedron is flat and its faces wind at random. EPA must still answer
+    depth 0 along the face's normal. (Before the seed measured flatness as a height, 4 % of these poses left no
+    face alive, and EPA then read a face row it had never written: a crash, an IndexError with
+    NUMBA_BOUNDSCHECK=1, or garbage.)"""
+    g = geometry(ConvexHull(CUBE_POINTS), Sphere(0.1))
+    xa, xb = gjk.core_proxy(g, 0, -1), gjk.core_proxy(g, 1, -1)
+    rng = np.random.default_rng(7)
+    for _ in range(100):
+        rot = Rotation.random(random_state=rng)
+        x, y, z, w = rot.as_quat()
+        qa = (float(w), float(x), float(y), float(z))
+        pa = tuple(float(c) for c in rng.uniform(-1, 1, 3))
+        pb = tuple(float(c) for c in np.add(pa, rot.apply([*rng.uniform(-0.5, 0.5, 2), 0.5])))
+        sim_a, sim_b = _face_corners_simplex(g, rot, pa, qa, pb, rng.permutation(4))
+        status, depth, n, _, point_b = gjk.proxy_epa(xa, pa, qa, xb, pb, IDENTITY, g.vertex_local, sim_a, sim_b,
+                                                     np.int64(4))  # fmt: skip
+        assert status == gjk.EPA_CONVERGED
+        assert abs(depth) <= 1e-12  # measured 4e-16
+        np.testing.assert_allclose(n, rot.apply([0, 0, 1]), atol=1e-12)  # measured 8e-16
+        np.testing.assert_allclose(point_b, pb, atol=1e-12)
+
+
+def test_epa_with_non_finite_seed_gives_a_defined_answer():
+    """A simplex of NaN support points (a body that has blown up): no face has a finite distance, and EPA falls back
+    to the flat answer (depth 0, the line between the centres) instead of growing a polytope of NaNs."""
+    g = geometry(Box((1, 1, 1)), Cylinder(0.3, 0.5))
+    xa, xb = gjk.core_proxy(g, 0, -1), gjk.core_proxy(g, 1, -1)
+    sim_a, sim_b = np.full((4, 3), np.nan), np.zeros((4, 3))
+    status, depth, n, _, _ = gjk.proxy_epa(xa, (0.0, 0.0, 0.0), IDENTITY, xb, (0.0, 0.0, 0.5), IDENTITY,
+                                           g.vertex_local, sim_a, sim_b, np.int64(4))  # fmt: skip
+    assert status == gjk.EPA_FLAT and depth == 0.0
+    np.testing.assert_allclose(n, [0, 0, 1], atol=1e-12)
+
+
+def test_epa_step_that_sees_every_face_is_refused():
+    """A polytope whose faces all see the new point (here: faces with no area, which every point sees) leaves no
+    rim to fan: the step is refused (-1) instead of leaving no face alive."""
+    va = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [0.3, 0.3, 0.3]]) - 0.2
+    vb = np.zeros_like(va)
+    poly = gjk._epa_polytope()
+    gjk._epa_tetrahedron(va, vb, poly)
+    assert gjk._epa_nearest(poly[4], poly[5], 4) >= 0
+    poly[3][:4] = 0.0  # every face's normal gone: each one sees any point
+    assert gjk._epa_grow(va, vb, poly, 0, 4, 4, 0.0, 1e-9, 1e-12) == -1

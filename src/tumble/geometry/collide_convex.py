@@ -467,7 +467,8 @@ def _clip_points(ref, ref_count, ref_n, inc, inc_count, inc_radius, margin, base
     face's plane less ``inc_radius``, and writes those within ``margin``, midway between the two surfaces, into
     ``out_*`` (room for ``inc_count + ref_count`` rows). Returns how many.
     """
-    cap = inc_count + ref_count + 1
+    # A convex incident feature gains at most one vertex per side plane. Rows are written before they are read.
+    cap = inc_count + ref_count
     buf = np.empty((cap, 3))
     buf_ids = np.empty(cap, np.int64)
     tmp = np.empty((cap, 3))
@@ -507,15 +508,18 @@ def _clip_points(ref, ref_count, ref_n, inc, inc_count, inc_radius, margin, base
                     tmp_ids[end] = xid
                 out = 2
         else:
-            # Sutherland-Hodgman: keep the inside vertices and add a point where an edge crosses the plane.
+            # Sutherland-Hodgman: keep the inside vertices and add a point where an edge crosses the plane. A convex
+            # polygon gains at most one vertex per plane, which `cap` allows for; a polygon that round-off has made a
+            # little non-convex (points nearly in a line, crossing the plane in turn) can cross it more than twice,
+            # and the points past `cap` are dropped rather than written past the end.
             for k in range(m):
                 p, q = _row(buf, k), _row(buf, (k + 1) % m)
                 dp, dq = dot(sn, p) - so, dot(sn, q) - so
-                if dp <= 0.0:
+                if dp <= 0.0 and out < cap:
                     _set_row(tmp, out, p)
                     tmp_ids[out] = buf_ids[k]
                     out += 1
-                if (dp <= 0.0) != (dq <= 0.0):
+                if (dp <= 0.0) != (dq <= 0.0) and out < cap:
                     _set_row(tmp, out, add_scaled(p, sub(q, p), dp / (dp - dq)))
                     tmp_ids[out] = ((side + 1) << 8) | (buf_ids[k] & 0xFF)
                     out += 1

@@ -468,12 +468,30 @@ def proxy_gjk(xa, pa, qa, xb, pb, qb, vertices, max_distance, sim_a, sim_b):
         point_a = add_scaled(point_a, _row(sim_a, i), lam[i])
         point_b = add_scaled(point_b, _row(sim_b, i), lam[i])
     distance = math.sqrt(dot(v, v))
+    if status == GJK_SEPARATED and distance <= touching:
+        # Out of iterations on a last step that reached the origin: touching (and never a normal divided by 0).
+        status = GJK_OVERLAPPING
     if status == GJK_FAR:
         distance = dot(v, sub(a, b)) / distance
     return status, count, distance, point_a, point_b
 
 
 # --- EPA -------------------------------------------------------------------------------------------------------
+#
+# The Expanding Polytope Algorithm of van den Bergen (2001; 2003, §4.3.8), with the hole found by a walk over
+# neighbour links. :func:`proxy_epa` has four ways out, each its own function below:
+#
+# 1. the seed has no volume round the origin (``A - B`` is flat there): :func:`_epa_flat_answer`, ``EPA_FLAT``;
+# 2. the nearest face lies on the boundary of ``A - B``: ``EPA_CONVERGED`` (:func:`_epa_expand`);
+# 3. out of vertices, out of face slots, or a step that cannot be taken soundly (the new point sees every face, the
+#    hole's rim is not one loop, a new face comes out nearer than the old): ``EPA_STOPPED`` with the nearest face of
+#    the last sound polytope (:func:`_epa_grow` refuses the step, :func:`_epa_expand` keeps the answer);
+# 4. no face of the seed tetrahedron has a finite distance (only on non-finite input): the flat answer again.
+#
+# Every buffer is written before it is read. Vertex rows ``[:count]`` are written as they are made; a face slot's
+# vertices, normal and distance when its face is made, and only alive faces are read (``alive`` starts all False); a
+# neighbour link is followed only where ``adj`` is not -1 (it starts so), and ``adj_edge`` is written with it; the
+# walk's stack, the horizon and the fan are read only below their fill level.
 
 
 @kernel
@@ -490,11 +508,23 @@ def _epa_w(va, vb, i):
     return sub(_row(va, i), _row(vb, i))
 
 
+@inline
+def _copy_vertex(va, vb, to, source):
+    for c in range(3):
+        va[to, c], vb[to, c] = va[source, c], vb[source, c]
+
+
 @kernel
 def _epa_seed(xa, pa, qa, xb, pb, qb, vertices, va, vb, count, tol):
     """Grow GJK's simplex (1 to 4 points, the origin on or in it) into a tetrahedron: any point away from a single
-    point, the point farthest from a segment's line, the higher apex over a triangle. A flat tetrahedron from GJK
-    keeps its largest face. The origin is then inside or on the boundary (a face through it is fine for EPA).
+    point, the point farthest from a segment's line, the higher apex over a triangle. The origin is then inside or on
+    the boundary (a face through it is fine for EPA).
+
+    Flatness is measured as a height against ``tol``: a tetrahedron whose apex is within ``tol`` of the plane of its
+    largest face keeps its face round the origin (the one nearest it; of those, the largest), and a triangle whose
+    height over its longest edge is within ``tol`` keeps that edge. (A test of the volume in absolute units lets
+    through a tetrahedron flat to round-off, whose four faces then wind at random: the origin on a hull's face,
+    GJK's simplex four corners of that face.)
 
     Returns ``(count, hint)``: ``count >= 4`` on success. Otherwise ``A - B`` has no volume around the origin (two
     points, a point and a segment, two crossing segments, a point in a triangle's plane...) and ``hint`` is a
@@ -504,29 +534,41 @@ def _epa_seed(xa, pa, qa, xb, pb, qb, vertices, va, vb, count, tol):
     if count == 4:
         w0 = _epa_w(va, vb, 0)
         volume = dot(cross(sub(_epa_w(va, vb, 1), w0), sub(_epa_w(va, vb, 2), w0)), sub(_epa_w(va, vb, 3), w0))
-        if abs(volume) > tol * tol * tol:
-            return 4, hint
-        # Flat: keep the largest face (face f leaves out vertex f) in rows 0 to 2.
-        drop, most = 3, -1.0
+        # Face f leaves out vertex f; |volume| / |2 area| is the height over face f.
+        nearest, most = math.inf, 0.0
         for f in range(4):
             p, q, r = _epa_w(va, vb, (f + 1) % 4), _epa_w(va, vb, (f + 2) % 4), _epa_w(va, vb, (f + 3) % 4)
             area = cross(sub(q, p), sub(r, p))
-            if dot(area, area) > most:
-                drop, most = f, dot(area, area)
-        for c in range(3):
-            va[drop, c], vb[drop, c] = va[3, c], vb[3, c]
+            most = max(most, dot(area, area))
+            x = _closest_on_triangle(p, q, r)[0]
+            nearest = min(nearest, dot(x, x))
+        if volume * volume > tol * tol * most:
+            return 4, hint
+        keep, kept_area = 3, -1.0
+        for f in range(4):
+            p, q, r = _epa_w(va, vb, (f + 1) % 4), _epa_w(va, vb, (f + 2) % 4), _epa_w(va, vb, (f + 3) % 4)
+            x = _closest_on_triangle(p, q, r)[0]
+            area = cross(sub(q, p), sub(r, p))
+            if dot(x, x) <= nearest + tol * tol and dot(area, area) > kept_area:
+                keep, kept_area = f, dot(area, area)
+        _copy_vertex(va, vb, keep, 3)
         count = 3
     if count == 3:
-        w0 = _epa_w(va, vb, 0)
-        n = cross(sub(_epa_w(va, vb, 1), w0), sub(_epa_w(va, vb, 2), w0))
-        if dot(n, n) <= tol * tol * tol * tol:
-            # A sliver: keep its longest edge and grow again from there.
-            l01 = dot(sub(_epa_w(va, vb, 1), w0), sub(_epa_w(va, vb, 1), w0))
-            l02 = dot(sub(_epa_w(va, vb, 2), w0), sub(_epa_w(va, vb, 2), w0))
-            if l02 > l01:
-                for c in range(3):
-                    va[1, c], vb[1, c] = va[2, c], vb[2, c]
+        w0, w1, w2 = _epa_w(va, vb, 0), _epa_w(va, vb, 1), _epa_w(va, vb, 2)
+        n = cross(sub(w1, w0), sub(w2, w0))
+        l01, l02, l12 = dot(sub(w1, w0), sub(w1, w0)), dot(sub(w2, w0), sub(w2, w0)), dot(sub(w2, w1), sub(w2, w1))
+        if dot(n, n) <= tol * tol * max(l01, l02, l12):
+            # A sliver: keep its longest edge in rows 0 and 1, and grow again from there.
+            if l12 >= l01 and l12 >= l02:
+                _copy_vertex(va, vb, 0, 2)
+            elif l02 > l01:
+                _copy_vertex(va, vb, 1, 2)
             count = 2
+    if count == 2:
+        w0 = _epa_w(va, vb, 0)
+        u = sub(_epa_w(va, vb, 1), w0)
+        if dot(u, u) <= tol * tol:
+            count = 1
     if count == 1:
         # Any support point away from the first.
         w0 = _epa_w(va, vb, 0)
@@ -570,8 +612,7 @@ def _epa_seed(xa, pa, qa, xb, pb, qb, vertices, va, vb, count, tol):
     if max(up, down) <= tol:
         return 3, n
     if down > up:
-        for c in range(3):
-            va[count, c], vb[count, c] = va[count + 1, c], vb[count + 1, c]
+        _copy_vertex(va, vb, count, count + 1)
     return 4, hint
 
 
@@ -586,9 +627,37 @@ def _perpendicular(u):
 
 
 @kernel
+def _epa_flat_answer(xa, pa, qa, xb, pb, qb, vertices, va, vb, count, hint):
+    """Exit 1 (and 4): ``A - B`` has no volume round the origin. Depth 0, the normal of the flat set (see
+    :func:`_flat_normal`), and the mean of the ``count`` support pairs as the points."""
+    point_a, point_b = (0.0, 0.0, 0.0), (0.0, 0.0, 0.0)
+    for i in range(count):
+        point_a = add_scaled(point_a, _row(va, i), 1.0 / count)
+        point_b = add_scaled(point_b, _row(vb, i), 1.0 / count)
+    n = _flat_normal(xa, pa, qa, xb, pb, qb, vertices, va, vb, count, hint)
+    return EPA_FLAT, 0.0, n, point_a, point_b
+
+
+@kernel
+def _epa_polytope():
+    """The polytope's face arrays: ``(faces, adj, adj_edge, normal, dist, alive, stack, horizon, fan)``.
+
+    ``faces[f]`` are the vertex rows of face ``f``, wound outwards; ``adj[f, e]`` is the face across its edge ``e``
+    (from vertex ``e`` to ``e + 1``) and ``adj_edge[f, e]`` that face's number for the edge; ``normal`` and ``dist``
+    the unit outward normal and the distance of the face's plane from the origin. The walk pushes at most 3 + 2 per
+    removed face onto ``stack``, so ``2 * EPA_MAX_FACES + 3`` rows bound it, the horizon and the fan.
+    """
+    walk = 2 * EPA_MAX_FACES + 3
+    return (np.empty((EPA_MAX_FACES, 3), np.int64), np.full((EPA_MAX_FACES, 3), -1, np.int64),
+            np.empty((EPA_MAX_FACES, 3), np.int64), np.empty((EPA_MAX_FACES, 3)), np.empty(EPA_MAX_FACES),
+            np.zeros(EPA_MAX_FACES, np.bool_), np.empty((walk, 2), np.int64), np.empty((walk, 2), np.int64),
+            np.empty(walk, np.int64))  # fmt: skip
+
+
+@kernel
 def _epa_update_face(va, vb, faces, normal, dist, f):
     """Unit normal and origin distance of face ``f`` as wound (a face with no area: zero normal, infinite distance,
-    so it is never the nearest and never seen)."""
+    so it is never the nearest)."""
     wi = _epa_w(va, vb, faces[f, 0])
     n = cross(sub(_epa_w(va, vb, faces[f, 1]), wi), sub(_epa_w(va, vb, faces[f, 2]), wi))
     length = math.sqrt(dot(n, n))
@@ -613,51 +682,14 @@ def _epa_link(faces, adj, adj_edge, f, g):
 
 
 @kernel
-def proxy_epa(xa, pa, qa, xb, pb, qb, vertices, sim_a, sim_b, count):
-    """Penetration depth of overlapping cores, seeded with GJK's last simplex (``count`` rows of ``sim_a``/``sim_b``).
-
-    The polytope is a closed triangle mesh with neighbour links (``adj[f, e]`` is the face across edge ``e`` of face
-    ``f``, from vertex ``e`` to ``e + 1``). Each step removes the region of faces the new support point sees, found by
-    a walk over neighbours from the nearest face, so the region is always one connected patch and its boundary one
-    loop, and fills the hole with a fan of new faces to the point.
-
-    Returns:
-        ``(ok, depth, normal, point_a, point_b)``: the depth [m] (``>= 0`` up to round-off; slightly negative when the
-        cores only touch), the unit normal from A to B (moving B by ``depth · normal`` makes the cores touch) and the
-        deepest points of each core, world frame. ``ok`` is False when ``A - B`` has no volume around the origin;
-        ``normal`` is then a normal of that flat set (see :func:`_flat_normal`) and depth is 0.
-    """
-    size = xa[2] + xb[2]
-    tol = EPA_TOLERANCE * size
-    va = np.empty((EPA_MAX_VERTICES, 3))
-    vb = np.empty((EPA_MAX_VERTICES, 3))
-    faces = np.empty((EPA_MAX_FACES, 3), np.int64)
-    adj = np.full((EPA_MAX_FACES, 3), -1, np.int64)
-    adj_edge = np.empty((EPA_MAX_FACES, 3), np.int64)
-    normal = np.zeros((EPA_MAX_FACES, 3))
-    dist = np.empty(EPA_MAX_FACES)
-    alive = np.zeros(EPA_MAX_FACES, np.bool_)
-    stack = np.empty((3 * EPA_MAX_FACES, 2), np.int64)
-    horizon = np.empty((3 * EPA_MAX_FACES, 2), np.int64)
-    fan = np.empty(3 * EPA_MAX_FACES, np.int64)
-    for i in range(count):
-        for c in range(3):
-            va[i, c], vb[i, c] = sim_a[i, c], sim_b[i, c]
-    count, hint = _epa_seed(xa, pa, qa, xb, pb, qb, vertices, va, vb, count, tol)
-    if count < 4:
-        point_a, point_b = (0.0, 0.0, 0.0), (0.0, 0.0, 0.0)
-        for i in range(count):
-            point_a = add_scaled(point_a, _row(va, i), 1.0 / count)
-            point_b = add_scaled(point_b, _row(vb, i), 1.0 / count)
-        n = _flat_normal(xa, pa, qa, xb, pb, qb, vertices, va, vb, count, hint)
-        return EPA_FLAT, 0.0, n, point_a, point_b
-    # The seed tetrahedron (face f leaves out vertex f), each face wound to face away from its centroid, then linked
-    # to its neighbours.
+def _epa_tetrahedron(va, vb, poly):
+    """The seed tetrahedron in rows 0 to 3 as four faces (face f leaves out vertex f), each wound to face away from
+    the centroid, linked to its neighbours."""
+    faces, adj, adj_edge, normal, dist, alive = poly[0], poly[1], poly[2], poly[3], poly[4], poly[5]
     interior = (0.0, 0.0, 0.0)
     for i in range(4):
         interior = add_scaled(interior, _epa_w(va, vb, i), 0.25)
-    face_count = 4
-    for f in range(face_count):
+    for f in range(4):
         i, j, k = (f + 1) % 4, (f + 2) % 4, (f + 3) % 4
         wi = _epa_w(va, vb, i)
         if dot(cross(sub(_epa_w(va, vb, j), wi), sub(_epa_w(va, vb, k), wi)), sub(interior, wi)) > 0.0:
@@ -665,95 +697,123 @@ def proxy_epa(xa, pa, qa, xb, pb, qb, vertices, sim_a, sim_b, count):
         faces[f, 0], faces[f, 1], faces[f, 2] = i, j, k
         _epa_update_face(va, vb, faces, normal, dist, f)
         alive[f] = True
-    for f in range(face_count):
-        for g in range(f + 1, face_count):
+    for f in range(4):
+        for g in range(f + 1, 4):
             _epa_link(faces, adj, adj_edge, f, g)
-    # Faces this close to containing the new point in their plane count as seen, so that no sliver of a fan face
-    # can come out wound the wrong way.
-    flat = 1e-12 * size
-    depth, answer_face, answer_normal = 0.0, (0, 1, 2), (0.0, 0.0, 1.0)
-    status = EPA_STOPPED
-    for _ in range(EPA_MAX_VERTICES):
-        # The face nearest the origin (first of equals): the answer, unless the step below finds a better one.
-        best = -1
-        for f in range(face_count):
-            if alive[f] and (best < 0 or dist[f] < dist[best]):
-                best = f
-        # (Copied: the slot may be reused below.)
-        depth, answer_face, answer_normal = (
-            dist[best],
-            (faces[best, 0], faces[best, 1], faces[best, 2]),
-            _row(normal, best),
-        )
-        n = answer_normal
-        if count == EPA_MAX_VERTICES:
-            break
-        w = _epa_push(xa, pa, qa, xb, pb, qb, vertices, n, va, vb, count)
-        if dot(n, w) - dist[best] <= tol:
-            status = EPA_CONVERGED
-            break
-        # Walk from the nearest face over the faces the point sees; an edge to a face it does not see is the horizon.
-        alive[best] = False
-        top = 0
-        for e in range(3):
+
+
+@kernel
+def _epa_nearest(dist, alive, face_count):
+    """The alive face nearest the origin (first of equals), or -1 when no alive face has a finite distance."""
+    best = -1
+    for f in range(face_count):
+        if alive[f] and math.isfinite(dist[f]) and (best < 0 or dist[f] < dist[best]):
+            best = f
+    return best
+
+
+@kernel
+def _epa_grow(va, vb, poly, best, count, face_count, depth, tol, flat):
+    """Add vertex ``count`` (the support point beyond face ``best``) to the polytope: remove the faces it sees, found
+    by a walk over neighbours from ``best`` (so the hole is one connected patch), and fill the hole with a fan of faces
+    to the new point, reusing dead slots.
+
+    Faces within ``flat`` of containing the point in their plane count as seen, so that no sliver of a fan face comes
+    out wound the wrong way. Returns the new face count, or -1 when the step cannot be taken soundly (exit 3): the
+    point sees every face (a polytope flat to round-off), the hole's rim is not one loop, the slots run out, or a
+    new face is nearer the origin than ``depth`` (a grown convex polytope never is; round-off broke convexity). The
+    polytope is then left broken, and the caller stops with the answer it had.
+    """
+    faces, adj, adj_edge, normal, dist, alive, stack, horizon, fan = poly
+    w = _epa_w(va, vb, count)
+    alive[best] = False
+    top = 0
+    for e in range(3):
+        if adj[best, e] >= 0:
             stack[top, 0], stack[top, 1] = adj[best, e], adj_edge[best, e]
             top += 1
-        edge_count = 0
-        while top > 0:
-            top -= 1
-            g, k = stack[top, 0], stack[top, 1]
-            if g < 0 or not alive[g]:
-                continue
-            if dot(_row(normal, g), sub(w, _epa_w(va, vb, faces[g, 0]))) > -flat:
-                alive[g] = False
-                for e in (1, 2):
+    edge_count = 0
+    while top > 0:
+        top -= 1
+        g, k = stack[top, 0], stack[top, 1]
+        if not alive[g]:
+            continue
+        if dot(_row(normal, g), sub(w, _epa_w(va, vb, faces[g, 0]))) > -flat:
+            alive[g] = False
+            for e in (1, 2):
+                if adj[g, (k + e) % 3] >= 0:
                     stack[top, 0], stack[top, 1] = adj[g, (k + e) % 3], adj_edge[g, (k + e) % 3]
                     top += 1
-            else:
-                horizon[edge_count, 0], horizon[edge_count, 1] = g, k
-                edge_count += 1
-        # Fan the hole to the new point, reusing dead slots: across the horizon edge (a -> b of the kept face) the
-        # new face is (b, a, w), which keeps the winding of the faces it replaces.
-        slot = 0
-        linked = True
-        for h in range(edge_count):
-            while slot < face_count and alive[slot]:
-                slot += 1
-            if slot >= EPA_MAX_FACES:
-                linked = False
+        else:
+            horizon[edge_count, 0], horizon[edge_count, 1] = g, k
+            edge_count += 1
+    # A rim has at least three edges; none means the point saw every face.
+    if edge_count < 3:
+        return -1
+    # Across the horizon edge (a -> b of the kept face) the new face is (b, a, w), which keeps the winding.
+    slot = 0
+    for h in range(edge_count):
+        while slot < face_count and alive[slot]:
+            slot += 1
+        if slot >= EPA_MAX_FACES:
+            return -1
+        g, k = horizon[h, 0], horizon[h, 1]
+        faces[slot, 0], faces[slot, 1], faces[slot, 2] = faces[g, (k + 1) % 3], faces[g, k], count
+        adj[slot, 0], adj_edge[slot, 0] = g, k
+        adj[g, k], adj_edge[g, k] = slot, 0
+        _epa_update_face(va, vb, faces, normal, dist, slot)
+        alive[slot] = True
+        fan[h] = slot
+        if slot == face_count:
+            face_count += 1
+    # Link the fan's faces to each other: (b, a, w) meets the face whose edge starts at a ... ends at w.
+    for h in range(edge_count):
+        found = False
+        for h2 in range(edge_count):
+            if h2 != h and faces[fan[h2], 0] == faces[fan[h], 1]:
+                adj[fan[h], 1], adj_edge[fan[h], 1] = fan[h2], 2
+                adj[fan[h2], 2], adj_edge[fan[h2], 2] = fan[h], 1
+                found = True
                 break
-            g, k = horizon[h, 0], horizon[h, 1]
-            faces[slot, 0], faces[slot, 1], faces[slot, 2] = faces[g, (k + 1) % 3], faces[g, k], count
-            adj[slot, 0], adj_edge[slot, 0] = g, k
-            adj[g, k], adj_edge[g, k] = slot, 0
-            _epa_update_face(va, vb, faces, normal, dist, slot)
-            alive[slot] = True
-            fan[h] = slot
-            if slot == face_count:
-                face_count += 1
-        count += 1
-        if not linked:
-            break
-        # Link the fan's faces to each other: (b, a, w) meets the face whose edge starts at a ... ends at w.
-        for h in range(edge_count):
-            found = False
-            for h2 in range(edge_count):
-                if h2 != h and faces[fan[h2], 0] == faces[fan[h], 1]:
-                    adj[fan[h], 1], adj_edge[fan[h], 1] = fan[h2], 2
-                    adj[fan[h2], 2], adj_edge[fan[h2], 2] = fan[h], 1
-                    found = True
-                    break
-            linked = linked and found
-        # A grown convex polytope is never nearer the origin than before; a fan face that is means round-off broke
-        # convexity (or the horizon was not one loop): stop, with the answer of the last sound polytope.
-        for h in range(edge_count):
-            if dist[fan[h]] < depth - tol:
-                linked = False
-        if not linked:
-            break
-    # The origin's projection on the nearest face, in barycentric weights of that face's support pairs.
-    n = answer_normal
-    i, j, k = answer_face
+        if not found:
+            return -1
+    for h in range(edge_count):
+        if dist[fan[h]] < depth - tol:
+            return -1
+    return face_count
+
+
+@kernel
+def _epa_expand(xa, pa, qa, xb, pb, qb, vertices, va, vb, poly, tol, flat):
+    """Push out the nearest face until it lies on the boundary of ``A - B`` (exit 2) or no sound step is left
+    (exit 3). Returns ``(status, depth, face, normal)``: the nearest face's distance, vertex rows and unit normal;
+    ``EPA_FLAT`` when the seed has no face with a finite distance (exit 4)."""
+    faces, normal, dist, alive = poly[0], poly[3], poly[4], poly[5]
+    face_count = 4
+    best = _epa_nearest(dist, alive, face_count)
+    if best < 0:
+        return EPA_FLAT, 0.0, (0, 1, 2), (0.0, 0.0, 1.0)
+    for count in range(4, EPA_MAX_VERTICES):
+        # (Copied: the slot may be reused by the step below.)
+        depth, face, n = dist[best], (faces[best, 0], faces[best, 1], faces[best, 2]), _row(normal, best)
+        w = _epa_push(xa, pa, qa, xb, pb, qb, vertices, n, va, vb, count)
+        if dot(n, w) - depth <= tol:
+            return EPA_CONVERGED, depth, face, n
+        face_count = _epa_grow(va, vb, poly, best, count, face_count, depth, tol, flat)
+        if face_count < 0:
+            return EPA_STOPPED, depth, face, n
+        best = _epa_nearest(dist, alive, face_count)
+        if best < 0:
+            return EPA_STOPPED, depth, face, n
+    # Out of vertices: the nearest face of the full polytope.
+    return EPA_STOPPED, dist[best], (faces[best, 0], faces[best, 1], faces[best, 2]), _row(normal, best)
+
+
+@kernel
+def _epa_witnesses(va, vb, depth, face, n):
+    """The origin's projection on the answer's face, ``depth · n``, in barycentric weights of the face's support
+    pairs: the deepest points of A and B."""
+    i, j, k = face
     w0 = _epa_w(va, vb, i)
     e1, e2 = sub(_epa_w(va, vb, j), w0), sub(_epa_w(va, vb, k), w0)
     x = sub(scale(n, depth), w0)
@@ -767,6 +827,41 @@ def proxy_epa(xa, pa, qa, xb, pb, qb, vertices, sim_a, sim_b, count):
     l0 = 1.0 - l1 - l2
     point_a = add(add(scale(_row(va, i), l0), scale(_row(va, j), l1)), scale(_row(va, k), l2))
     point_b = add(add(scale(_row(vb, i), l0), scale(_row(vb, j), l1)), scale(_row(vb, k), l2))
+    return point_a, point_b
+
+
+@kernel
+def proxy_epa(xa, pa, qa, xb, pb, qb, vertices, sim_a, sim_b, count):
+    """Penetration depth of overlapping cores, seeded with GJK's last simplex (``count`` rows of ``sim_a``/``sim_b``).
+
+    The polytope is a closed triangle mesh with neighbour links (see :func:`_epa_polytope`); each step removes the
+    faces the new support point sees and fills the hole with a fan to the point (:func:`_epa_grow`). Every way out
+    returns a defined answer (see the list above :func:`_epa_push`).
+
+    Returns:
+        ``(status, depth, normal, point_a, point_b)``: the depth [m] (``>= 0`` up to round-off; slightly negative when
+        the cores only touch), the unit normal from A to B (moving B by ``depth · normal`` makes the cores touch) and
+        the deepest points of each core, world frame. ``status`` is ``EPA_FLAT`` when ``A - B`` has no volume around
+        the origin (``normal`` is then a normal of that flat set, see :func:`_flat_normal`, and depth is 0),
+        ``EPA_CONVERGED`` or ``EPA_STOPPED`` (the best face of the last sound polytope).
+    """
+    size = xa[2] + xb[2]
+    tol = EPA_TOLERANCE * size
+    # Rows [:count] are written before they are read (the seed's copy, then one push per vertex).
+    va = np.empty((EPA_MAX_VERTICES, 3))
+    vb = np.empty((EPA_MAX_VERTICES, 3))
+    for i in range(count):
+        for c in range(3):
+            va[i, c], vb[i, c] = sim_a[i, c], sim_b[i, c]
+    count, hint = _epa_seed(xa, pa, qa, xb, pb, qb, vertices, va, vb, count, tol)
+    if count < 4:
+        return _epa_flat_answer(xa, pa, qa, xb, pb, qb, vertices, va, vb, count, hint)
+    poly = _epa_polytope()
+    _epa_tetrahedron(va, vb, poly)
+    status, depth, face, n = _epa_expand(xa, pa, qa, xb, pb, qb, vertices, va, vb, poly, tol, 1e-12 * size)
+    if status == EPA_FLAT:
+        return _epa_flat_answer(xa, pa, qa, xb, pb, qb, vertices, va, vb, np.int64(1), hint)
+    point_a, point_b = _epa_witnesses(va, vb, depth, face, n)
     return status, depth, n, point_a, point_b
 
 
