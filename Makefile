@@ -5,7 +5,7 @@ PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
 BROWSER_STAMP := $(VENV)/.browser
 
-.PHONY: install demo test test-nojit bench lint clean
+.PHONY: install demo test test-slow bench lint clean
 
 $(STAMP): pyproject.toml
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
@@ -25,9 +25,25 @@ $(BROWSER_STAMP): $(STAMP)
 	test -x /usr/bin/chromium || { apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium; }
 	touch $(BROWSER_STAMP)
 
+# What every change passes before it is submitted (under 8 minutes from a fresh clone): everything but the tests
+# marked slow, then the unit tests again as plain Python (NUMBA_DISABLE_JIT=1).
 test: $(STAMP) $(BROWSER_STAMP)
-	$(PY) -m pytest -q
+	$(PY) -m pytest -q -m "not slow"
 	NUMBA_DISABLE_JIT=1 $(PY) -m pytest -q tests/unit -m "not slow" -p no:cacheprovider
+
+# The narrow phase, GJK/EPA and contact tests, run again with every array access bounds-checked: an index out of
+# range raises IndexError instead of reading or writing memory it does not own.
+BOUNDSCHECK_TESTS := tests/unit/test_gjk.py tests/unit/test_collide_convex.py tests/unit/test_collide_primitives.py \
+	tests/unit/test_broad_phase.py tests/unit/test_contact_api.py tests/unit/test_query_overlap.py \
+	tests/properties/test_convex_properties.py tests/properties/test_collide_properties.py \
+	tests/analytic/test_contact.py
+
+# The tests marked slow (every shipped scene at every rate, the long scenes), then the bounds-checked pass. Numba's
+# cache does not tell a bounds-checked build from a plain one, so that pass compiles into a cache of its own.
+test-slow: $(STAMP)
+	$(PY) -m pytest -q -m slow
+	NUMBA_BOUNDSCHECK=1 NUMBA_CACHE_DIR=$(VENV)/numba-boundscheck $(PY) -m pytest -q -m "not slow" \
+		-p no:cacheprovider $(BOUNDSCHECK_TESTS)
 
 bench: $(STAMP)
 	$(PY) -m pip install --quiet -e ".[bench]"

@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import functools
 import hashlib
-import os
 from pathlib import Path
 
 import numba
@@ -55,8 +54,8 @@ def _package_stamp(leaf: str | None = None) -> str:
     return digest.hexdigest()
 
 
-class _PackageCacheLocator(caching.InTreeCacheLocator):
-    """Numba's on-disk cache beside the sources, invalidated when any core tumble source changes.
+class _PackageStamp:
+    """Numba's on-disk cache, invalidated when any core tumble source changes (a mixin for Numba's locators).
 
     Numba stamps a cached kernel with its own file only, but a kernel embeds the code of the helpers it calls
     from other files: after an edit of ``contact_solver.py`` (or an upgrade of the package over an old cache)
@@ -74,8 +73,16 @@ class _PackageCacheLocator(caching.InTreeCacheLocator):
         return super().from_function(py_func, py_file)
 
 
-if os.environ.get("NUMBA_CACHE_DIR") is None:  # a user-chosen cache directory keeps Numba's own rules
-    caching.CacheImpl._locator_classes.insert(0, _PackageCacheLocator)
+class _PackageCacheLocator(_PackageStamp, caching.InTreeCacheLocator):
+    """The cache beside the sources (``__pycache__``)."""
+
+
+class _PackageUserDirLocator(_PackageStamp, caching.UserProvidedCacheLocator):
+    """The cache in ``NUMBA_CACHE_DIR`` when one is set (``make test-slow`` gives its bounds-checked kernels their own,
+    as Numba's cache index does not tell a bounds-checked build from a plain one)."""
+
+
+caching.CacheImpl._locator_classes[:0] = [_PackageUserDirLocator, _PackageCacheLocator]
 
 
 def kernel(function=None, *, parallel: bool = False):
