@@ -141,3 +141,40 @@ def test_joint_forces_drive_sliders_and_ball_joints_as_the_articulation_says():
     art.step(1 / 600, tau=tau)
     np.testing.assert_allclose(copy.qd, art.qd, rtol=2e-2, atol=1e-6)
     assert copy.qd[0] > 0 and copy.qd[2] > 0  # the right directions, not just small numbers
+
+
+def _arm():
+    """The shipped robot_arm's three links: two capsules hinged about y, a cube hinged about x at the end."""
+    art = Articulation(base_position=(0.0, 0.0, 1.0))
+    shoulder = art.add_link(Revolute((0, 1, 0)), shape=tumble.Capsule(0.04, 0.4), mass=2.0,
+                            shape_position=(0, 0, -0.2))  # fmt: skip
+    elbow = art.add_link(Revolute((0, 1, 0)), parent=shoulder, position=(0, 0, -0.4), shape=tumble.Capsule(0.035, 0.35),
+                         mass=1.5, shape_position=(0, 0, -0.175))  # fmt: skip
+    art.add_link(Revolute((1, 0, 0)), parent=elbow, position=(0, 0, -0.35), shape=tumble.Box((0.12, 0.12, 0.12)),
+                 mass=0.5, shape_position=(0, 0, -0.06))  # fmt: skip
+    art.q = [-1.4, 0.2, 0.3]
+    return art
+
+
+@pytest.fixture(scope="module")
+def arm_after_3_s():
+    art = _arm()
+    art.simulate(3.0, 1e-4, integrator="rk4", record_every=30000)
+    return art.q.copy()
+
+
+@pytest.mark.parametrize(("rate", "q_tolerance"), [(60, 0.1), (240, 0.01), (1000, 0.002)])
+def test_an_arm_with_a_cross_axis_wrist_keeps_its_energy_at_every_rate(rate, q_tolerance, arm_after_3_s):
+    """A hinge's accumulated impulse turned off its rows by the joint's motion (onto the free axis) was warm-started
+    again every substep: it spun the wrist up until the arm blew up (energy +24 % at 60 Hz, +130 % at 1000 Hz in
+    3 s; non-finite at 1000 Hz in the robot_arm scene). Measured now: energy within 0.14 % (60 Hz), 0.03 % and
+    0.008 %; q within 0.05, 3.4e-3 and 2.5e-4 rad of the articulation (RK4 at 10 kHz)."""
+    world = tumble.World()
+    copy = world.add_articulation(_arm())
+    start = world.total_energy()
+    worst = 0.0
+    for _ in range(6):
+        world.simulate(0.5, 1 / rate, record_every=rate)
+        worst = max(worst, abs(world.total_energy() - start) / start)
+    assert worst < 3e-3
+    np.testing.assert_allclose(copy.q, arm_after_3_s, atol=q_tolerance)

@@ -416,6 +416,7 @@ def solve_joints(joints, impulses, inv_mass, inv_inertia_world, pos, quat, linve
     inv_h = 1.0 / h
     dir_l, dir_a, dir_b, error, rhs, k_block = _block_work()
     coupling = np.zeros(6)
+    accumulated = np.zeros(6)
     soft = soft_coefficients(min(joint_hertz, 0.25 * inv_h), joint_damping_ratio, h)
     for j in range(joints.kind.shape[0]):
         a, b, kind = joints.body_a[j], joints.body_b[j], joints.kind[j]
@@ -517,9 +518,14 @@ def solve_joints(joints, impulses, inv_mass, inv_inertia_world, pos, quat, linve
             for r in range(rows):
                 old_r = dot(old_p, load3(dir_l, r)) if r < linear_rows else dot(old_m, load3(dir_a, r))
                 rhs[r] -= i_scale * old_r
+                accumulated[r] = old_r + rhs[r]
             p, m, turn_a, turn_b = _block_impulse(rows, linear_rows, rhs, dir_l, dir_a, dir_b)
-            store3(linear, j, add(old_p, p))
-            store3(angular_impulse, j, add(old_m, m))
+            # The accumulated impulse is kept on the rows as they are now: the part of the old one that the joint's
+            # turning has carried off them (onto a hinge's free axis, a slider's) is no reaction of this block, and
+            # warm starting it again would drive the free axis (a wrist spun up until the arm blew up).
+            kept_p, kept_m, _, _ = _block_impulse(rows, linear_rows, accumulated, dir_l, dir_a, dir_b)
+            store3(linear, j, kept_p if linear_rows > 0 else old_p)
+            store3(angular_impulse, j, kept_m if rows > linear_rows else old_m)
             va, vb = add_scaled(va, p, -ma), add_scaled(vb, p, mb)
             wa, wb = sub(wa, mat_vec(ia, turn_a)), add(wb, mat_vec(ib, turn_b))
             got_p, got_m = add(got_p, p), add(got_m, m)
