@@ -34,6 +34,7 @@ from ..math3d import (
     load33,
     mat_vec,
     quat_conj,
+    quat_integrate,
     quat_mul,
     quat_rotate,
     scale,
@@ -308,9 +309,15 @@ def warm_start_contacts(rows, count, inv_mass, inv_inertia_world, pos, quat, pos
 
 @kernel
 def solve_contacts(
-    rows, count, inv_mass, inv_inertia_world, pos, quat, pos0, quat0, linvel, angvel, inv_h, push_max, use_bias
-):
+    rows, count, inv_mass, inv_inertia_world, pos, quat, pos0, quat0, linvel, angvel, inv_h, push_max, use_bias,
+    threshold,
+):  # fmt: skip
     """One Gauss–Seidel pass over all contacts: normal impulses (soft when ``use_bias``), then friction.
+
+    A ball that will bounce (one point, restitution, closing faster than ``threshold``) is not held to the
+    speculative ``vn ≥ −s/h`` by the relax pass while it is still apart: :func:`resolve_impacts` bounces it in the
+    substep of the touch with the speed it has there. Slowed to close the gap in one more substep, it kept only
+    ``((s/h + g h) / v)²`` of its rebound energy, anywhere from 0 to 1 with where the touch fell in the substep.
 
     Reads: rows, body poses now (``pos``, ``quat``) and at the start of the step (``pos0``, ``quat0``).
     Writes: rows.normal_impulse, rows.tangent_impulse, rows.max_normal_impulse, linvel, angvel.
@@ -323,16 +330,19 @@ def solve_contacts(
         )
         n, t1, t2 = load3(rows.normal, m), load3(rows.tangent1, m), load3(rows.tangent2, m)
         bias_rate, mass_scale, impulse_scale = rows.softness[m, 0], rows.softness[m, 1], rows.softness[m, 2]
+        will_bounce = not use_bias and rows.restitution[m] > 0.0 and rows.point_count[m] == 1
         # Non-penetration: λn ≥ 0, soft towards zero separation; speculative while apart.
         for jj in range(rows.sweeps[m] * rows.point_count[m]):
             j = jj % rows.point_count[m]
             ra, rb, s = _arms_now(rows, m, j, n, dx_a, dq_a, dx_b, dq_b, weight_b)
+            vn = dot(_relative_velocity(va, wa, ra, vb, wb, rb), n)
+            if s > 0.0 and will_bounce and vn < -threshold:
+                continue
             bias, m_scale, i_scale = 0.0, 1.0, 0.0
             if s > 0.0:
                 bias = s * inv_h
             elif use_bias:
                 bias, m_scale, i_scale = max(bias_rate * s, -push_max), mass_scale, impulse_scale
-            vn = dot(_relative_velocity(va, wa, ra, vb, wb, rb), n)
             if use_bias and rows.max_normal_impulse[m, j] == 0.0:
                 # Not pushed yet this step: the approach speed at the substep of impact is what bounces.
                 rows.relative_velocity[m, j] = min(rows.relative_velocity[m, j], vn)
@@ -370,16 +380,61 @@ def solve_contacts(
         _store_pair(linvel, angvel, a, b, va, wa, vb, wb)
 
 
+@inline
+def _load_acceleration(i, inv_mass, gravity, force, constant_force):
+    """Body ``i``'s acceleration from gravity and its applied and constant forces (zero if it does not move)."""
+    if inv_mass[i] == 0.0:
+        return (0.0, 0.0, 0.0)
+    applied = add(load3(force, i), load3(constant_force, i))
+    return add_scaled((gravity[0], gravity[1], gravity[2]), applied, inv_mass[i])
+
+
+@inline
+def _time_of_touch(s, u_half, g_n, h):
+    """When a gap ``s`` closes within a substep ``h``, and how fast: ``(τ, u_s)``, or ``τ = -1`` if it does not.
+
+    ``u_half`` is the approach speed the substep moves with: semi-implicit Euler's velocity leads the positions
+    by half a substep, so it is the speed at ``h/2``, and ``u0 = u_half − g_n h/2`` the speed at the start, with
+    ``g_n`` the rate at which the loads speed the approach up. Then ``s = u0 τ + ½ g_n τ²`` and ``u_s² = u0² +
+    2 g_n s``; exact for constant loads, as semi-implicit Euler is. A gap already closed touches at 0."""
+    u0 = u_half - 0.5 * g_n * h
+    if s <= 0.0:
+        return 0.0, u0
+    squared = u0 * u0 + 2.0 * g_n * s
+    if squared < 0.0:
+        return -1.0, 0.0
+    u_s = math.sqrt(squared)
+    if u0 + u_s <= 0.0:
+        return -1.0, 0.0
+    return min(2.0 * s / (u0 + u_s), h), u_s
+
+
+@inline
+def _move_back(i, dv, dw, tau, inv_mass, pos, quat):
+    """Undo ``τ`` of body ``i``'s motion with a velocity change it got at ``τ`` into the substep."""
+    if inv_mass[i] == 0.0:
+        return
+    store3(pos, i, add_scaled(load3(pos, i), dv, -tau))
+    q = quat_integrate((quat[i, 0], quat[i, 1], quat[i, 2], quat[i, 3]), dw, -tau)
+    quat[i, 0], quat[i, 1], quat[i, 2], quat[i, 3] = q[0], q[1], q[2], q[3]
+
+
 @kernel
-def resolve_impacts(rows, count, inv_mass, inv_inertia_world, pos, quat, pos0, quat0, linvel, angvel, h, threshold):
+def resolve_impacts(rows, count, inv_mass, inv_inertia_world, pos, quat, pos0, quat0, linvel, angvel, h, threshold,
+                    gravity, force, constant_force):  # fmt: skip
     """Bounce single-point impacts (balls) as they happen, one after the other, so momentum passes along a row.
 
-    Called at the start of a substep: a one-point contact with restitution ``e`` that closes faster than
-    ``threshold`` and will touch within the substep gets the fresh impulse that turns its normal velocity ``vn``
-    into ``-e vn``; sweeps repeat while any such contact remains (a struck ball then strikes the next: Newton's
-    cradle). Resolving them inside the substeps' inelastic solve instead would merge a touching row into one
-    body. Manifolds of several points bounce after the substeps (:func:`apply_restitution`), where one corner
-    cannot take the whole impact. Writes: linvel, angvel.
+    Called at the start of a substep, after the velocities: a one-point contact with restitution ``e`` that closes
+    faster than ``threshold`` and touches within the substep, at ``τ`` (:func:`_time_of_touch`), turns its approach
+    speed *at the surface* ``u_s`` into ``e u_s``: the impulse is ``(1 + e) u_s`` times the point's effective mass.
+    Semi-implicit Euler then moves the bodies with their new velocities over the whole substep, so each body is
+    moved back by its velocity change times ``τ``: the positions at the end of the substep are those of the exact
+    motion (constant loads), and the bounce does not depend on where the touch falls in the substep (issue 16).
+    Those moves conserve the centre of mass, and a struck ball that strikes the next at the same instant keeps
+    its place (its two velocity changes cancel). Sweeps repeat while any such contact remains (a struck ball then
+    strikes the next: Newton's cradle). Resolving them inside the substeps' inelastic solve instead would merge
+    a touching row into one body. Manifolds of several points bounce after the substeps
+    (:func:`apply_restitution`). Writes: linvel, angvel, pos, quat.
     """
     for _ in range(count + 1):
         bounced = False
@@ -395,9 +450,21 @@ def resolve_impacts(rows, count, inv_mass, inv_inertia_world, pos, quat, pos0, q
             vn = dot(_relative_velocity(va, wa, ra, vb, wb, rb), n)
             if vn >= -threshold or s > -vn * h + 1e-9:  # (1 nm: a gap that closes exactly at the substep's end)
                 continue
-            impulse = scale(n, -(1.0 + e) * rows.normal_mass[m, 0] * vn)
-            va, wa, vb, wb = _apply_impulse(ra, rb, impulse, ma, ia, mb, ib, va, wa, vb, wb)
-            _store_pair(linvel, angvel, a, b, va, wa, vb, wb)
+            acc_a = _load_acceleration(a, inv_mass, gravity, force, constant_force)
+            acc_b = _load_acceleration(b, inv_mass, gravity, force, constant_force)
+            tau, u_s = _time_of_touch(s, -vn, -dot(n, sub(acc_b, acc_a)), h)
+            if tau < 0.0:
+                continue
+            # At the arms of time τ, both reaching the same point (as in _arms_now): the impulse then exerts no net
+            # moment where the bodies are when it acts, and moving them back keeps the angular momentum.
+            relative = scale(sub(vb, va), tau)
+            ra, rb = add_scaled(ra, relative, weight_b), add_scaled(rb, relative, weight_b - 1.0)
+            impulse = scale(n, (1.0 + e) * rows.normal_mass[m, 0] * u_s)
+            va2, wa2, vb2, wb2 = _apply_impulse(ra, rb, impulse, ma, ia, mb, ib, va, wa, vb, wb)
+            _store_pair(linvel, angvel, a, b, va2, wa2, vb2, wb2)
+            if tau > 0.0:
+                _move_back(a, sub(va2, va), sub(wa2, wa), tau, inv_mass, pos, quat)
+                _move_back(b, sub(vb2, vb), sub(wb2, wb), tau, inv_mass, pos, quat)
             rows.relative_velocity[m, 0] = 0.0  # bounced: the pass after the substeps leaves it alone
             bounced = True
         if not bounced:

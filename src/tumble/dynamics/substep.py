@@ -8,8 +8,6 @@ state is ω (world frame), which the contact impulses change directly; the step 
 
 from __future__ import annotations
 
-import os
-
 from .._jit import kernel
 from ..math3d import (
     add,
@@ -29,7 +27,6 @@ from .contact_solver import accumulate_impulses, resolve_impacts, solve_contacts
 from .free_motion import implicit_spin
 from .joint_solver import solve_joints, warm_start_joints
 
-PROJECT = int(os.environ.get("PROJECT", "1"))
 __all__ = ["run_substeps", "to_angular_velocity", "to_angular_momentum"]
 
 
@@ -99,17 +96,18 @@ def run_substeps(
     inv_h = 1.0 / h
     for _ in range(substeps):
         integrate_velocities(bodies, moving, gravity, force, torque, quat, linvel, angvel, h)
-        resolve_impacts(rows, count, inv_mass, inv_inertia_world, pos, quat, pos0, quat0, linvel, angvel, h, threshold)
+        resolve_impacts(rows, count, inv_mass, inv_inertia_world, pos, quat, pos0, quat0, linvel, angvel, h, threshold,
+                        gravity, force, bodies.constant_force)  # fmt: skip
         warm_start_joints(joints, joint_impulses, inv_mass, inv_inertia_world, pos, quat, linvel, angvel,
                           joint_force_total, joint_moment_total)  # fmt: skip
         warm_start_contacts(rows, count, inv_mass, inv_inertia_world, pos, quat, pos0, quat0, linvel, angvel)
         solve_joints(joints, joint_impulses, inv_mass, inv_inertia_world, pos, quat, linvel, angvel, h, joint_hertz,
                      joint_damping_ratio, True, joint_force_total, joint_moment_total)  # fmt: skip
         solve_contacts(rows, count, inv_mass, inv_inertia_world, pos, quat, pos0, quat0, linvel, angvel, inv_h,
-                       push_max, True)  # fmt: skip
+                       push_max, True, threshold)  # fmt: skip
         integrate_positions(moving, linvel, angvel, pos, quat, h)
         solve_joints(joints, joint_impulses, inv_mass, inv_inertia_world, pos, quat, linvel, angvel, h, joint_hertz,
                      joint_damping_ratio, False, joint_force_total, joint_moment_total)  # fmt: skip
         solve_contacts(rows, count, inv_mass, inv_inertia_world, pos, quat, pos0, quat0, linvel, angvel, inv_h,
-                       push_max, False)  # fmt: skip
+                       push_max, False, threshold)  # fmt: skip
         accumulate_impulses(rows, count)
