@@ -5,8 +5,10 @@ runs ``substeps`` small steps of ``h = dt / substeps``. In every substep the vel
 impulses of the last substep are re-applied (warm start), the contact constraints are solved once by
 sequential impulses with a *soft* position bias (a spring of ``contact_hertz`` and damping ratio, see
 ``softness.py``), the positions are integrated, and a relax pass solves the constraints again without bias
-so that the push-out does not leave velocity behind. After the substeps, restitution is applied once from
-the relative normal velocities recorded before the step. Contacts with positive separation are speculative:
+so that the push-out does not leave velocity behind. Impacts with restitution bounce in the substep where they
+touch, at the time of touch, with the approach speed at the surface (:func:`resolve_impacts`); after the substeps,
+restitution is applied once more, from the velocities recorded before the step, to the points that pushed without
+having bounced (:func:`apply_restitution`). Contacts with positive separation are speculative:
 they only stop the bodies from closing the gap faster than ``separation / h``, which keeps fast bodies
 from tunnelling through each other.
 
@@ -50,6 +52,9 @@ from .softness import soft_coefficients
 # the 1000-box pile sway and topple at 60 Hz, and cost 45 % more time.
 IMPACT_SWEEPS = 4
 IMPACT_SPEED = 1.0  # [m/s]
+# Projected Gauss-Seidel sweeps at most over the points of one bounce (resolve_impacts): a flat box's four corners
+# converge to the joint (symmetric) solution in a handful; one point needs one.
+IMPACT_BLOCK_SWEEPS = 32
 
 __all__ = ["ContactRows", "SolverSettings", "prepare_contacts", "solve_contacts", "warm_start_contacts"]
 
@@ -330,7 +335,7 @@ def solve_contacts(
         )
         n, t1, t2 = load3(rows.normal, m), load3(rows.tangent1, m), load3(rows.tangent2, m)
         bias_rate, mass_scale, impulse_scale = rows.softness[m, 0], rows.softness[m, 1], rows.softness[m, 2]
-        will_bounce = not use_bias and rows.restitution[m] > 0.0 and rows.point_count[m] == 1
+        will_bounce = not use_bias and rows.restitution[m] > 0.0
         # Non-penetration: λn ≥ 0, soft towards zero separation; speculative while apart.
         for jj in range(rows.sweeps[m] * rows.point_count[m]):
             j = jj % rows.point_count[m]
@@ -422,50 +427,88 @@ def _move_back(i, dv, dw, tau, inv_mass, pos, quat):
 @kernel
 def resolve_impacts(rows, count, inv_mass, inv_inertia_world, pos, quat, pos0, quat0, linvel, angvel, h, threshold,
                     gravity, force, constant_force):  # fmt: skip
-    """Bounce single-point impacts (balls) as they happen, one after the other, so momentum passes along a row.
+    """Bounce impacts as they happen, at the time of touch within the substep, one after the other, so momentum
+    passes along a row.
 
-    Called at the start of a substep, after the velocities: a one-point contact with restitution ``e`` that closes
-    faster than ``threshold`` and touches within the substep, at ``τ`` (:func:`_time_of_touch`), turns its approach
-    speed *at the surface* ``u_s`` into ``e u_s``: the impulse is ``(1 + e) u_s`` times the point's effective mass.
-    Semi-implicit Euler then moves the bodies with their new velocities over the whole substep, so each body is
-    moved back by its velocity change times ``τ``: the positions at the end of the substep are those of the exact
-    motion (constant loads), and the bounce does not depend on where the touch falls in the substep (issue 16).
-    Those moves conserve the centre of mass, and a struck ball that strikes the next at the same instant keeps
-    its place (its two velocity changes cancel). Sweeps repeat while any such contact remains (a struck ball then
-    strikes the next: Newton's cradle). Resolving them inside the substeps' inelastic solve instead would merge
-    a touching row into one body. Manifolds of several points bounce after the substeps
-    (:func:`apply_restitution`). Writes: linvel, angvel, pos, quat.
+    Called at the start of a substep, after the velocities. In a manifold with restitution ``e``, the points that
+    close faster than ``threshold`` and touch within the substep first, at ``τ`` (:func:`_time_of_touch`; a flat face
+    touches with all its points at once), bounce together: their approach speeds *at the surface* ``u_s`` become
+    ``e u_s``, by impulses at the arms of time ``τ`` solved jointly (projected Gauss–Seidel to convergence,
+    ``λ ≥ 0``), so that a box landing flat leaves without a spin. Semi-implicit Euler then moves the bodies with
+    their new velocities over the whole substep, so each body is moved back by its velocity change times ``τ``: the
+    positions at the end of the substep are those of the exact motion (constant loads), and the bounce does not
+    depend on where the touch falls in the substep (issue 16). The moves keep the centre of mass and, with the
+    impulses at the arms of time ``τ``, the angular momentum; a struck ball that strikes the next at the same
+    instant keeps its place (its two velocity changes cancel). Sweeps repeat while any contact bounced: a struck
+    ball then strikes the next (Newton's cradle), and a corner that touches later in the substep bounces then.
+    Resolving the impacts inside the substeps' inelastic solve instead would merge a touching row into one body.
+    Writes: linvel, angvel, pos, quat, and ``rows.relative_velocity`` (0: bounced, so that
+    :func:`apply_restitution` leaves the point alone).
     """
+    u_surface = np.zeros(MAX_POINTS)
+    target = np.zeros(MAX_POINTS)
+    impulse = np.zeros(MAX_POINTS)
     for _ in range(count + 1):
         bounced = False
         for m in range(count):
             e = rows.restitution[m]
-            if e == 0.0 or rows.point_count[m] != 1 or rows.normal_mass[m, 0] == 0.0:
+            if e == 0.0 or rows.normal_mass[m, 0] == 0.0:
                 continue
             a, b, ma, ia, mb, ib, va, wa, vb, wb, dx_a, dq_a, dx_b, dq_b, weight_b = _load_pair(
                 rows, m, inv_mass, inv_inertia_world, pos, quat, pos0, quat0, linvel, angvel
             )
             n = load3(rows.normal, m)
-            ra, rb, s = _arms_now(rows, m, 0, n, dx_a, dq_a, dx_b, dq_b, weight_b)
-            vn = dot(_relative_velocity(va, wa, ra, vb, wb, rb), n)
-            if vn >= -threshold or s > -vn * h + 1e-9:  # (1 nm: a gap that closes exactly at the substep's end)
-                continue
             acc_a = _load_acceleration(a, inv_mass, gravity, force, constant_force)
             acc_b = _load_acceleration(b, inv_mass, gravity, force, constant_force)
-            tau, u_s = _time_of_touch(s, -vn, -dot(n, sub(acc_b, acc_a)), h)
-            if tau < 0.0:
+            g_n = -dot(n, sub(acc_b, acc_a))
+            # The first touch in this substep, and each point's touch.
+            tau = math.inf
+            for j in range(rows.point_count[m]):
+                ra, rb, s = _arms_now(rows, m, j, n, dx_a, dq_a, dx_b, dq_b, weight_b)
+                vn = dot(_relative_velocity(va, wa, ra, vb, wb, rb), n)
+                u_surface[j] = -1.0
+                if vn >= -threshold or s > -vn * h + 1e-9:  # (1 nm: a gap that closes exactly at the substep's end)
+                    continue
+                t_j, u_j = _time_of_touch(s, -vn, g_n, h)
+                if t_j >= 0.0:
+                    u_surface[j], target[j] = u_j, t_j
+                    tau = min(tau, t_j)
+            if tau == math.inf:
                 continue
-            # At the arms of time τ, both reaching the same point (as in _arms_now): the impulse then exerts no net
-            # moment where the bodies are when it acts, and moving them back keeps the angular momentum.
+            # The points that touch at τ (to round-off) bounce together: λ ≥ 0 with vn → −u_half + (1 + e) u_s.
             relative = scale(sub(vb, va), tau)
-            ra, rb = add_scaled(ra, relative, weight_b), add_scaled(rb, relative, weight_b - 1.0)
-            impulse = scale(n, (1.0 + e) * rows.normal_mass[m, 0] * u_s)
-            va2, wa2, vb2, wb2 = _apply_impulse(ra, rb, impulse, ma, ia, mb, ib, va, wa, vb, wb)
+            for j in range(rows.point_count[m]):
+                if u_surface[j] >= 0.0 and target[j] > tau + 1e-9 * h:
+                    u_surface[j] = -1.0
+                if u_surface[j] >= 0.0:
+                    ra, rb, _ = _arms_now(rows, m, j, n, dx_a, dq_a, dx_b, dq_b, weight_b)
+                    ra, rb = add_scaled(ra, relative, weight_b), add_scaled(rb, relative, weight_b - 1.0)
+                    target[j] = dot(_relative_velocity(va, wa, ra, vb, wb, rb), n) + (1.0 + e) * u_surface[j]
+                impulse[j] = 0.0
+            va2, wa2, vb2, wb2 = va, wa, vb, wb
+            for _sweep in range(IMPACT_BLOCK_SWEEPS):
+                largest, total = 0.0, 0.0
+                for j in range(rows.point_count[m]):
+                    if u_surface[j] < 0.0:
+                        continue
+                    ra, rb, _ = _arms_now(rows, m, j, n, dx_a, dq_a, dx_b, dq_b, weight_b)
+                    ra, rb = add_scaled(ra, relative, weight_b), add_scaled(rb, relative, weight_b - 1.0)
+                    vn = dot(_relative_velocity(va2, wa2, ra, vb2, wb2, rb), n)
+                    new = max(impulse[j] + rows.normal_mass[m, j] * (target[j] - vn), 0.0)
+                    va2, wa2, vb2, wb2 = _apply_impulse(ra, rb, scale(n, new - impulse[j]), ma, ia, mb, ib, va2, wa2,
+                                                        vb2, wb2)  # fmt: skip
+                    largest = max(largest, abs(new - impulse[j]))
+                    impulse[j] = new
+                    total += new
+                if largest <= 1e-12 * total:
+                    break
             _store_pair(linvel, angvel, a, b, va2, wa2, vb2, wb2)
             if tau > 0.0:
                 _move_back(a, sub(va2, va), sub(wa2, wa), tau, inv_mass, pos, quat)
                 _move_back(b, sub(vb2, vb), sub(wb2, wb), tau, inv_mass, pos, quat)
-            rows.relative_velocity[m, 0] = 0.0  # bounced: the pass after the substeps leaves it alone
+            for j in range(rows.point_count[m]):
+                if u_surface[j] >= 0.0:
+                    rows.relative_velocity[m, j] = 0.0
             bounced = True
         if not bounced:
             break
@@ -473,7 +516,8 @@ def resolve_impacts(rows, count, inv_mass, inv_inertia_world, pos, quat, pos0, q
 
 @kernel
 def apply_restitution(rows, count, inv_mass, inv_inertia_world, pos, quat, pos0, quat0, linvel, angvel, threshold):
-    """Bounce: drive the normal velocity to ``−e`` times its approach velocity, where there was an impact.
+    """Bounce: drive the normal velocity to ``−e`` times its approach velocity, where there was an impact that
+    :func:`resolve_impacts` did not bounce (one that sped up past ``threshold`` only in the substep it touched).
 
     Only points that approached faster than ``threshold`` and pushed during the step bounce (Box2D v3).
     Reads: rows.relative_velocity, rows.max_normal_impulse. Writes: rows.normal_impulse, linvel, angvel.
