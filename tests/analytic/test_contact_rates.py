@@ -17,6 +17,7 @@ import pytest
 
 import tumble
 from tumble import scenes
+from tumble.rotation import quat_from_axis_angle
 
 G = 9.81
 RATES = (30, 60, 120, 240, 1000)
@@ -89,3 +90,96 @@ def test_newtons_cradle_passes_the_striker_speed_whatever_the_phase_of_its_touch
         assert world.body("last").velocity[0] == pytest.approx(2.0, rel=0.01)
         assert world.kinetic_energy() == pytest.approx(energy, rel=0.01)
         assert abs(striker.velocity[0]) < 0.02
+
+
+# --- friction, rolling and resting contact across the grid (tolerances as in test_contact.py) -----------------------
+
+
+def ramp_world(theta: float, mu: float, substeps: int):
+    """A plane through the origin tilted by ``theta`` about y (downhill is +x), friction ``mu``."""
+    world = tumble.World(substeps=substeps)
+    normal = np.array([-np.sin(theta), 0.0, np.cos(theta)])
+    world.add_static(tumble.Plane(normal=tuple(normal)), friction=mu)
+    return world, normal, np.array([np.cos(theta), 0.0, np.sin(theta)])  # uphill direction
+
+
+def box_on_ramp(theta_deg: float, mu: float, substeps: int):
+    theta = np.radians(theta_deg)
+    world, normal, uphill = ramp_world(theta, mu, substeps)
+    box = world.add_body(tumble.Box((0.2, 0.2, 0.2)), density=500.0, position=0.1 * normal, friction=mu,
+                         orientation=quat_from_axis_angle((0, 1, 0), -theta))  # fmt: skip
+    return world, box, uphill
+
+
+def downhill_acceleration(world, body, uphill, rate: int) -> float:
+    trajectory = world.simulate(1.0, 1 / rate)
+    s = -(trajectory.position[:, body.index] @ uphill)
+    return float(2 * np.polyfit(trajectory.time - trajectory.time[0], s, 2)[0])
+
+
+@pytest.mark.parametrize(("rate", "substeps"), GRID)
+def test_a_box_sticks_on_a_ramp_below_the_friction_angle(rate, substeps):
+    world, box, _ = box_on_ramp(30.0, 0.7, substeps)  # tan 30° = 0.58 < 0.7
+    world.simulate(0.5, 1 / rate)
+    start = box.position
+    world.simulate(2.0, 1 / rate)
+    assert np.linalg.norm(box.position - start) < 1e-3  # measured at most 0.2 mm (30 Hz, 1 substep)
+
+
+@pytest.mark.parametrize(("rate", "substeps"), GRID)
+def test_a_box_slides_down_a_ramp_at_g_sin_minus_mu_cos(rate, substeps):
+    theta, mu = np.radians(30.0), 0.3
+    world, box, uphill = box_on_ramp(30.0, mu, substeps)
+    world.simulate(0.25, 1 / rate)
+    expected = G * (np.sin(theta) - mu * np.cos(theta))
+    assert downhill_acceleration(world, box, uphill, rate) == pytest.approx(expected, rel=0.03)  # measured 1e-4
+
+
+@pytest.mark.parametrize(("rate", "substeps"), GRID)
+def test_a_ball_rolls_down_a_ramp_at_five_sevenths_g_sin_theta(rate, substeps):
+    theta, mu = np.radians(20.0), 0.6
+    world, normal, uphill = ramp_world(theta, mu, substeps)
+    ball = world.add_body(tumble.Sphere(0.1), density=1000.0, position=0.1 * normal, friction=mu)
+    world.simulate(0.1, 1 / rate)
+    # Measured within 1.1 % (30 Hz, 1 substep), 0.3 % at 60 Hz.
+    assert downhill_acceleration(world, ball, uphill, rate) == pytest.approx(5 / 7 * G * np.sin(theta), rel=0.03)
+
+
+@pytest.mark.parametrize(("rate", "substeps"), GRID)
+def test_a_sliding_box_stops_after_v0_squared_over_2_mu_g(rate, substeps):
+    mu, v0 = 0.4, 3.0
+    world = tumble.World(substeps=substeps)
+    world.add_static(tumble.Plane(), friction=mu)
+    box = world.add_body(tumble.Box((0.2, 0.2, 0.2)), density=500.0, position=(0, 0, 0.1), friction=mu)
+    world.simulate(0.2, 1 / rate)
+    x0 = box.position[0]
+    box.velocity = (v0, 0.0, 0.0)
+    world.simulate(2.0, 1 / rate)
+    assert abs(box.velocity[0]) < 1e-3
+    # Semi-implicit Euler stops short by v0 h / 2 (its velocities lead its positions by half a substep): a relative
+    # μ g h / v0, 4.4 % at 30 Hz with one substep, 1.1 % at 30 Hz with 4; the test allows it on top of the 3 %.
+    h = 1 / (rate * substeps)
+    assert box.position[0] - x0 == pytest.approx(v0**2 / (2 * mu * G), rel=0.03 + mu * G * h / v0)
+
+
+# Cells where the ten-box tower does not hold (issue 16, part 3, open): with one substep the single Gauss-Seidel
+# sweep per substep does not carry the load of ten boxes, and stiffer contacts (the cap at a quarter of the
+# substep rate raised to half, one or no cap) make it no better. Measured: collapses at 30 and 60 Hz, 30 cm of
+# sway at 120 Hz; with 4 substeps 3.4 cm at 30 Hz and 1.5 cm at 60 Hz (bound 1 cm).
+TOWER_FAILS = {(30, 1), (60, 1), (120, 1), (30, 4), (60, 4)}
+
+
+@pytest.mark.parametrize(
+    ("rate", "substeps"),
+    [pytest.param(*cell.values, marks=(*cell.marks, pytest.mark.xfail(strict=True, reason="issue 16, part 3")))
+     if tuple(cell.values) in TOWER_FAILS else cell for cell in GRID],
+)  # fmt: skip
+def test_a_ten_box_tower_stands(rate, substeps):
+    world = tumble.World(substeps=substeps)
+    world.add_static(tumble.Plane())
+    boxes = [world.add_body(tumble.Box((0.5, 0.5, 0.5)), density=500.0, position=(0, 0, 0.25 + 0.5 * k))
+             for k in range(10)]  # fmt: skip
+    top = boxes[-1].position
+    world.simulate(10.0, 1 / rate)
+    assert np.linalg.norm(boxes[-1].position - top) < 0.01  # measured 5.8-8.3 mm where it holds, most of it sag
+    assert all(np.linalg.norm(b.velocity) < 1e-2 for b in boxes)
