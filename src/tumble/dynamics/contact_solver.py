@@ -445,8 +445,9 @@ def resolve_impacts(rows, count, inv_mass, inv_inertia_world, pos, quat, pos0, q
     Writes: linvel, angvel, pos, quat, and ``rows.relative_velocity`` (0: bounced, so that
     :func:`apply_restitution` leaves the point alone).
     """
-    u_surface = np.zeros(MAX_POINTS)
-    target = np.zeros(MAX_POINTS)
+    u_surface = np.zeros(MAX_POINTS)  # each point's approach speed at its touch (-1: it does not bounce now)
+    touch = np.zeros(MAX_POINTS)  # when it touches within the substep [s]
+    target = np.zeros(MAX_POINTS)  # the normal velocity its bounce leaves it with
     impulse = np.zeros(MAX_POINTS)
     for _ in range(count + 1):
         bounced = False
@@ -471,14 +472,14 @@ def resolve_impacts(rows, count, inv_mass, inv_inertia_world, pos, quat, pos0, q
                     continue
                 t_j, u_j = _time_of_touch(s, -vn, g_n, h)
                 if t_j >= 0.0:
-                    u_surface[j], target[j] = u_j, t_j
+                    u_surface[j], touch[j] = u_j, t_j
                     tau = min(tau, t_j)
             if tau == math.inf:
                 continue
             # The points that touch at τ (to round-off) bounce together: λ ≥ 0 with vn → −u_half + (1 + e) u_s.
             relative = scale(sub(vb, va), tau)
             for j in range(rows.point_count[m]):
-                if u_surface[j] >= 0.0 and target[j] > tau + 1e-9 * h:
+                if u_surface[j] >= 0.0 and touch[j] > tau + 1e-9 * h:
                     u_surface[j] = -1.0
                 if u_surface[j] >= 0.0:
                     ra, rb, _ = _arms_now(rows, m, j, n, dx_a, dq_a, dx_b, dq_b, weight_b)
