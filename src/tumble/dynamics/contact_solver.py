@@ -319,9 +319,9 @@ def solve_contacts(
 ):  # fmt: skip
     """One Gauss–Seidel pass over all contacts: normal impulses (soft when ``use_bias``), then friction.
 
-    A ball that will bounce (one point, restitution, closing faster than ``threshold``) is not held to the
-    speculative ``vn ≥ −s/h`` by the relax pass while it is still apart: :func:`resolve_impacts` bounces it in the
-    substep of the touch with the speed it has there. Slowed to close the gap in one more substep, it kept only
+    A point that will bounce (restitution, closing faster than ``threshold``) is not held to the speculative
+    ``vn ≥ −s/h`` by the relax pass while it is still apart: :func:`resolve_impacts` bounces it in the substep of
+    the touch with the speed it has there. Slowed to close the gap in one more substep, it kept only
     ``((s/h + g h) / v)²`` of its rebound energy, anywhere from 0 to 1 with where the touch fell in the substep.
 
     Reads: rows, body poses now (``pos``, ``quat``) and at the start of the step (``pos0``, ``quat0``).
@@ -449,6 +449,7 @@ def resolve_impacts(rows, count, inv_mass, inv_inertia_world, pos, quat, pos0, q
     touch = np.zeros(MAX_POINTS)  # when it touches within the substep [s]
     target = np.zeros(MAX_POINTS)  # the normal velocity its bounce leaves it with
     impulse = np.zeros(MAX_POINTS)
+    arm_a, arm_b = np.zeros((MAX_POINTS, 3)), np.zeros((MAX_POINTS, 3))  # the arms at the time of touch
     for _ in range(count + 1):
         bounced = False
         for m in range(count):
@@ -459,41 +460,44 @@ def resolve_impacts(rows, count, inv_mass, inv_inertia_world, pos, quat, pos0, q
                 rows, m, inv_mass, inv_inertia_world, pos, quat, pos0, quat0, linvel, angvel
             )
             n = load3(rows.normal, m)
-            acc_a = _load_acceleration(a, inv_mass, gravity, force, constant_force)
-            acc_b = _load_acceleration(b, inv_mass, gravity, force, constant_force)
-            g_n = -dot(n, sub(acc_b, acc_a))
-            # The first touch in this substep, and each point's touch.
-            tau = math.inf
+            # Each point's touch in this substep, and the first of them (the loads only where one closes in time).
+            tau, g_n, loaded = math.inf, 0.0, False
             for j in range(rows.point_count[m]):
                 ra, rb, s = _arms_now(rows, m, j, n, dx_a, dq_a, dx_b, dq_b, weight_b)
                 vn = dot(_relative_velocity(va, wa, ra, vb, wb, rb), n)
                 u_surface[j] = -1.0
                 if vn >= -threshold or s > -vn * h + 1e-9:  # (1 nm: a gap that closes exactly at the substep's end)
                     continue
+                if not loaded:
+                    acc_a = _load_acceleration(a, inv_mass, gravity, force, constant_force)
+                    acc_b = _load_acceleration(b, inv_mass, gravity, force, constant_force)
+                    g_n, loaded = -dot(n, sub(acc_b, acc_a)), True
                 t_j, u_j = _time_of_touch(s, -vn, g_n, h)
                 if t_j >= 0.0:
                     u_surface[j], touch[j] = u_j, t_j
                     tau = min(tau, t_j)
             if tau == math.inf:
                 continue
-            # The points that touch at τ (to round-off) bounce together: λ ≥ 0 with vn → −u_half + (1 + e) u_s.
+            # The points that touch at τ (to round-off) bounce together, at their arms of time τ (reaching one point,
+            # as in _arms_now): λ ≥ 0 with vn → −u_half + (1 + e) u_s, by projected Gauss-Seidel.
             relative = scale(sub(vb, va), tau)
             for j in range(rows.point_count[m]):
-                if u_surface[j] >= 0.0 and touch[j] > tau + 1e-9 * h:
-                    u_surface[j] = -1.0
-                if u_surface[j] >= 0.0:
-                    ra, rb, _ = _arms_now(rows, m, j, n, dx_a, dq_a, dx_b, dq_b, weight_b)
-                    ra, rb = add_scaled(ra, relative, weight_b), add_scaled(rb, relative, weight_b - 1.0)
-                    target[j] = dot(_relative_velocity(va, wa, ra, vb, wb, rb), n) + (1.0 + e) * u_surface[j]
                 impulse[j] = 0.0
+                if u_surface[j] < 0.0 or touch[j] > tau + 1e-9 * h:
+                    u_surface[j] = -1.0
+                    continue
+                ra, rb, _ = _arms_now(rows, m, j, n, dx_a, dq_a, dx_b, dq_b, weight_b)
+                ra, rb = add_scaled(ra, relative, weight_b), add_scaled(rb, relative, weight_b - 1.0)
+                store3(arm_a, j, ra)
+                store3(arm_b, j, rb)
+                target[j] = dot(_relative_velocity(va, wa, ra, vb, wb, rb), n) + (1.0 + e) * u_surface[j]
             va2, wa2, vb2, wb2 = va, wa, vb, wb
             for _sweep in range(IMPACT_BLOCK_SWEEPS):
                 largest, total = 0.0, 0.0
                 for j in range(rows.point_count[m]):
                     if u_surface[j] < 0.0:
                         continue
-                    ra, rb, _ = _arms_now(rows, m, j, n, dx_a, dq_a, dx_b, dq_b, weight_b)
-                    ra, rb = add_scaled(ra, relative, weight_b), add_scaled(rb, relative, weight_b - 1.0)
+                    ra, rb = load3(arm_a, j), load3(arm_b, j)
                     vn = dot(_relative_velocity(va2, wa2, ra, vb2, wb2, rb), n)
                     new = max(impulse[j] + rows.normal_mass[m, j] * (target[j] - vn), 0.0)
                     va2, wa2, vb2, wb2 = _apply_impulse(ra, rb, scale(n, new - impulse[j]), ma, ia, mb, ib, va2, wa2,

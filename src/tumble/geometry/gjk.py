@@ -535,15 +535,18 @@ def _epa_seed(xa, pa, qa, xb, pb, qb, vertices, va, vb, count, tol):
         w0 = _epa_w(va, vb, 0)
         volume = dot(cross(sub(_epa_w(va, vb, 1), w0), sub(_epa_w(va, vb, 2), w0)), sub(_epa_w(va, vb, 3), w0))
         # Face f leaves out vertex f; |volume| / |2 area| is the height over face f.
-        nearest, most = math.inf, 0.0
+        most = 0.0
         for f in range(4):
             p, q, r = _epa_w(va, vb, (f + 1) % 4), _epa_w(va, vb, (f + 2) % 4), _epa_w(va, vb, (f + 3) % 4)
             area = cross(sub(q, p), sub(r, p))
             most = max(most, dot(area, area))
-            x = _closest_on_triangle(p, q, r)[0]
-            nearest = min(nearest, dot(x, x))
         if volume * volume > tol * tol * most:
             return 4, hint
+        nearest = math.inf
+        for f in range(4):
+            p, q, r = _epa_w(va, vb, (f + 1) % 4), _epa_w(va, vb, (f + 2) % 4), _epa_w(va, vb, (f + 3) % 4)
+            x = _closest_on_triangle(p, q, r)[0]
+            nearest = min(nearest, dot(x, x))
         keep, kept_area = 3, -1.0
         for f in range(4):
             p, q, r = _epa_w(va, vb, (f + 1) % 4), _epa_w(va, vb, (f + 2) % 4), _epa_w(va, vb, (f + 3) % 4)
