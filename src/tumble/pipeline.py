@@ -137,7 +137,8 @@ def _fastest_body(state: State, is_dynamic: np.ndarray) -> int:
 def contact_step(model: Model, state: State, inputs: Inputs, params: Params, scratch: Scratch, dt: float) -> None:
     """One soft step of ``dt`` (see the module docstring for the stages)."""
     settings = params.solver
-    h = dt / settings.substeps
+    substeps = settings.substeps_for(dt)
+    h = dt / substeps
     bodies, geom = model.body_arrays, model.geometry
     angvel, inv_inertia_world = scratch.body_angvel, scratch.body_inv_inertia_world
     # Angular velocities and world inverse inertias at the start of the step.
@@ -252,7 +253,7 @@ def contact_step(model: Model, state: State, inputs: Inputs, params: Params, scr
         state.body_linvel,
         angvel,
         h,
-        settings.substeps,
+        substeps,
         settings.contact_push_max,
         settings.restitution_threshold,
         model.joints,

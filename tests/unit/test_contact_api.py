@@ -87,6 +87,23 @@ def test_free_integrators_refuse_a_world_with_contacts():
         world.step(DT)
 
 
+@pytest.mark.parametrize(
+    ("substeps", "hertz", "dt", "taken"),
+    [(8, 60.0, 1 / 60, 8), (1, 60.0, 1 / 60, 8), (1, 60.0, 1 / 30, 16), (1, 60.0, 1 / 120, 4), (1, 60.0, 1 / 480, 1),
+     (1, 60.0, 1 / 1000, 1), (4, 60.0, 1 / 1000, 4), (1, 30.0, 1 / 60, 4), (1, 120.0, 1 / 60, 16), (3, 60.0, 0.05, 24)],
+)  # fmt: skip
+def test_a_step_takes_at_least_eight_substeps_per_contact_period(substeps, hertz, dt, taken):
+    """Static contacts at 2 contact_hertz hold up to a quarter of the substep rate: the rate is 8 contact_hertz at
+    least (1/60 s times 480 Hz is 8.000000000000002 in floating point, and still 8 substeps)."""
+    assert tumble.World(substeps=substeps, contact_hertz=hertz).solver.substeps_for(dt) == taken
+
+
+@pytest.mark.parametrize("dt", [0.0, -0.01, float("nan"), "fast"])
+def test_substeps_for_names_a_bad_step(dt):
+    with pytest.raises((ValueError, TypeError), match="dt"):
+        tumble.World().solver.substeps_for(dt)
+
+
 def test_solver_settings_are_validated():
     world = tumble.World(substeps=8, contact_hertz=60.0)
     assert world.solver.substeps == 8 and world.solver.contact_hertz == 60.0

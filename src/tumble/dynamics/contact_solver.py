@@ -26,6 +26,7 @@ from typing import NamedTuple
 import numpy as np
 
 from .._jit import inline, kernel
+from .._validate import as_float
 from ..geometry.manifold import MAX_POINTS
 from ..math3d import (
     add,
@@ -55,6 +56,11 @@ IMPACT_SPEED = 1.0  # [m/s]
 # Projected Gauss-Seidel sweeps at most over the points of one bounce (resolve_impacts): a flat box's four corners
 # converge to the joint (symmetric) solution in a handful; one point needs one.
 IMPACT_BLOCK_SWEEPS = 32
+# The substep rate a contact of f hertz needs: static contacts run at 2 f, and a soft contact holds only up to a
+# quarter of the substep rate (Box2D v3's bound h ω <= π/2; stiffer, contacts jitter and stacks topple). Below that
+# rate the contacts would be softer than asked, and a stack sags by (load / m_eff) g / ω² at each contact: the
+# ten-box tower toppled at 30 and 60 Hz with one substep and swayed 15-34 mm with four (issue 16).
+SUBSTEP_RATE_PER_CONTACT_HERTZ = 8.0
 
 __all__ = ["ContactRows", "SolverSettings", "prepare_contacts", "solve_contacts", "warm_start_contacts"]
 
@@ -74,6 +80,14 @@ class SolverSettings(NamedTuple):
     time_to_sleep: float  # [s] ... for this long may sleep with its island
     joint_hertz: float  # joints' position correction: a spring of this frequency ...
     joint_damping_ratio: float  # ... and damping ratio (joint_solver.py)
+
+    def substeps_for(self, dt: float) -> int:
+        """The substeps a step of ``dt`` takes: ``substeps``, or more where the substep would be too long for
+        contacts of ``contact_hertz`` (at least 8 substeps per contact period: 8 at 60 Hz with the default 60 Hz
+        contacts, 16 at 30 Hz, 1 from 480 Hz on)."""
+        dt = as_float("dt", dt, positive=True)
+        needed = math.ceil(dt * SUBSTEP_RATE_PER_CONTACT_HERTZ * self.contact_hertz * (1.0 - 1e-12))
+        return max(self.substeps, needed)
 
 
 class ContactRows(NamedTuple):
@@ -189,9 +203,9 @@ def prepare_contacts(
         rows.rolling[m] = max(shape_rolling[manifolds.shape_a[m]], shape_rolling[manifolds.shape_b[m]])
         rows.core_radius[m, 0] = shape_core_radius[manifolds.shape_a[m]]
         rows.core_radius[m, 1] = shape_core_radius[manifolds.shape_b[m]]
-        # A contact against a static body is stiffer (2x), as it has half the effective mass to move.
+        # A contact against a static body is stiffer (2x), as it has half the effective mass to move; the step's
+        # substeps keep it within a quarter of the substep rate (SolverSettings.substeps_for).
         hertz = contact_hertz if inv_mass[a] > 0.0 and inv_mass[b] > 0.0 else 2.0 * contact_hertz
-        hertz = min(hertz, 0.25 / h)  # Box2D's bound: a quarter of the substep rate (h ω <= π/2)
         bias_rate, mass_scale, impulse_scale = soft_coefficients(hertz, damping_ratio, h)
         rows.softness[m, 0], rows.softness[m, 1], rows.softness[m, 2] = bias_rate, mass_scale, impulse_scale
         ma, mb = inv_mass[a], inv_mass[b]
