@@ -15,6 +15,7 @@ import numpy as np
 from . import diagnostics
 from ._validate import as_float, as_quaternion, as_vector3, mass_or_density
 from .builder import ModelBuilder, ShapeSpec
+from .control import Controller, Controllers
 from .errors import SimulationError
 from .handles import Body, Joint
 from .inputs import Inputs
@@ -198,6 +199,7 @@ class World:
         self._pending: list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = []
         self._bodies: list[Body] = []
         self._joints: list[Joint] = []
+        self._controllers = Controllers()
 
     # --- building -----------------------------------------------------------------------------------
 
@@ -306,6 +308,18 @@ class World:
         from .world_articulation import add_articulation
 
         return add_articulation(self, articulation)
+
+    def add_controller(self, callback, rate: float | None = None, name: str | None = None) -> Controller:
+        """Run ``callback(world, t)`` before each step, or with ``rate`` (Hz) before the first step at or past each
+        tick ``k / rate``; what it commands holds until its next call. ``t`` is the step's start time, counted as
+        steps of ``dt`` (see ``tumble.control``). Returns a handle with ``.remove()``. A controller that raises
+        stops ``step``/``simulate`` with a :class:`SimulationError` naming it and the time."""
+        return self._controllers.add(callback, rate, name)
+
+    @property
+    def controllers(self) -> list[Controller]:
+        """The controllers, in the order they run."""
+        return list(self._controllers)
 
     def to_scene(self, *, dt: float | None = None, duration: float | None = None) -> dict:
         """This world now as a scene dict, the structure of a scene file (``tumble.scene_file.dumps`` writes it as
@@ -462,6 +476,7 @@ class World:
             SimulationError: the step produced a non-finite value; the world keeps its state from before.
         """
         dt = as_float("dt", dt, positive=True)
+        self._controllers.run(self, dt)
         self._sync()
         steps_done, failing = simulate_steps(self._model, self._state, self._inputs, self._params, self._scratch, dt)
         if failing >= 0:
@@ -483,26 +498,49 @@ class World:
         self._sync()
         t0, initial = self._state.time, self._state.copy()
         recording = Trajectory.allocate_recording(self._state.body_count, n_steps // record_every)
-        steps_done, failing = simulate_steps(
-            self._model,
-            self._state,
-            self._inputs,
-            self._params,
-            self._scratch,
-            dt,
-            n_steps,
-            recording,
-            int(record_every),
-        )
+        controller_error = None
+        if self._controllers:
+            steps_done, failing, controller_error = self._simulate_stepwise(dt, n_steps, recording, int(record_every))
+        else:
+            steps_done, failing = simulate_steps(
+                self._model,
+                self._state,
+                self._inputs,
+                self._params,
+                self._scratch,
+                dt,
+                n_steps,
+                recording,
+                int(record_every),
+            )
         frames = steps_done // record_every
         trajectory = Trajectory.from_recording(
             self._model, initial, recording, frames, t0 + dt * record_every * np.arange(1, frames + 1), dt
         )
-        if failing >= 0:
-            error = self._simulation_error(failing)
+        if controller_error is not None or failing >= 0:
+            error = controller_error if controller_error is not None else self._simulation_error(failing)
             error.trajectory = trajectory
             raise error
         return trajectory
+
+    def _simulate_stepwise(self, dt: float, n_steps: int, recording, record_every: int):
+        """Step by step from Python, the controllers before each step: ``(steps_done, failing_body, error)``."""
+        for step in range(n_steps):
+            try:
+                self._controllers.run(self, dt)
+            except SimulationError as error:
+                return step, -1, error
+            self._sync()
+            if self._state.body_count != recording.pos.shape[1]:
+                raise ValueError("a controller added bodies during simulate; add them before it, or between calls")
+            _, failing = simulate_steps(self._model, self._state, self._inputs, self._params, self._scratch, dt)
+            if failing >= 0:
+                return step, failing, None
+            if (step + 1) % record_every == 0:
+                frame = (step + 1) // record_every - 1
+                for name in ("pos", "quat", "linvel", "angmom"):
+                    np.copyto(getattr(recording, name)[frame], getattr(self._state, f"body_{name}"))
+        return n_steps, -1, None
 
     def _simulation_error(self, row: int) -> SimulationError:
         name = self._model.body_name[row]

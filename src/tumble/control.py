@@ -1,0 +1,123 @@
+"""Controllers: Python code that runs before the steps of a world, each at its own rate (zero-order hold).
+
+A controller is ``callback(world, t)``. Without a rate it runs before every step; with ``rate`` (Hz) it runs before
+the first step whose start time is at or past each tick ``k / rate`` (``k = 0, 1, ...``), once per step even when
+a step spans several ticks. Whatever it commands (actuator commands, applied loads it stores elsewhere) holds
+until its next call: a zero-order hold, as a digital controller on real hardware.
+
+Time is counted, not accumulated: ``t = t0 + n dt`` with ``n`` the steps taken at this ``dt`` since ``t0`` (the
+time when ``dt`` last changed), so a 10 s run at 100 Hz has exactly 1000 steps and a 50 Hz controller in a 1 kHz
+world runs at exactly every 20th step. A tick counts as reached within a billionth of a step of it.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+
+from .errors import SimulationError
+
+__all__ = ["Controller", "Controllers"]
+
+# A tick at most this fraction of a step after the step's start time counts as reached (round-off in k / rate).
+_TICK_TOLERANCE = 1e-9
+
+
+class Controller:
+    """Handle of a controller in a world (``world.add_controller``).
+
+    Attributes:
+        callback: the callable, ``callback(world, t)``.
+        rate: calls per simulated second, or ``None`` for every step.
+        name: the name given, else the callback's name.
+        calls: how many times it has run.
+    """
+
+    def __init__(self, owner: Controllers, callback: Callable, rate: float | None, name: str):
+        self._owner = owner
+        self.callback = callback
+        self.rate = rate
+        self.name = name
+        self.calls = 0
+        self._next_tick = 0  # the index k of the next tick k / rate
+
+    def remove(self) -> None:
+        """Stop running this controller (removing it twice is an error)."""
+        self._owner.remove(self)
+
+    def _due(self, t: float, dt: float) -> bool:
+        if self.rate is None:
+            return True
+        return t >= self._next_tick / self.rate - _TICK_TOLERANCE * dt
+
+    def _advance(self, t: float, dt: float) -> None:
+        if self.rate is not None:  # the first tick after this step's start
+            self._next_tick = max(self._next_tick + 1, math.floor((t + _TICK_TOLERANCE * dt) * self.rate) + 1)
+
+    def __repr__(self) -> str:
+        rate = "every step" if self.rate is None else f"{self.rate:g} Hz"
+        return f"<Controller {self.name!r} at {rate}, {self.calls} calls>"
+
+
+class Controllers:
+    """A world's controllers, in the order added, and its counted clock."""
+
+    def __init__(self):
+        self._items: list[Controller] = []
+        self._origin = (0.0, 0, math.nan)  # (time, step count, dt) when dt last changed
+
+    def __len__(self) -> int:
+        return len(self._items)
+
+    def __iter__(self):
+        return iter(list(self._items))
+
+    def add(self, callback, rate=None, name=None) -> Controller:
+        if not callable(callback):
+            raise TypeError(f"callback must be callable as callback(world, t), got {callback!r}")
+        if rate is not None:
+            if isinstance(rate, bool) or not isinstance(rate, (int, float)) or not math.isfinite(rate) or rate <= 0:
+                raise ValueError(f"rate must be a finite number of Hz > 0 or None, got {rate!r}")
+            rate = float(rate)
+        if name is None:
+            name = getattr(callback, "__name__", type(callback).__name__)
+        elif not isinstance(name, str):
+            raise TypeError(f"name must be a string or None, got {name!r}")
+        controller = Controller(self, callback, rate, name)
+        self._items.append(controller)
+        return controller
+
+    def remove(self, controller: Controller) -> None:
+        if controller not in self._items:
+            raise ValueError(f"controller {controller.name!r} is not in this world (removed already?)")
+        self._items.remove(controller)
+
+    def time(self, world_time: float, step_count: int, dt: float) -> float:
+        """The start time of the next step of ``dt``: counted from when ``dt`` last changed."""
+        origin_time, origin_step, origin_dt = self._origin
+        if dt != origin_dt or step_count < origin_step:
+            self._origin = origin_time, origin_step, origin_dt = world_time, step_count, dt
+        return origin_time + (step_count - origin_step) * dt
+
+    def run(self, world, dt: float) -> None:
+        """Run the controllers due before the next step of ``dt``.
+
+        Raises:
+            SimulationError: a controller raised; the message names it and the time, the world is as it was.
+        """
+        state = world.state
+        t = self.time(state.time, state.step_count, dt)
+        for controller in self:
+            if not controller._due(t, dt):
+                continue
+            try:
+                controller.callback(world, t)
+            except Exception as error:
+                raise SimulationError(
+                    f"controller {controller.name!r} raised {type(error).__name__}: {error} at t = {t:.6g} s "
+                    f"(before step {state.step_count}); the world keeps its state from before that step",
+                    step=state.step_count,
+                    controller=controller.name,
+                ) from error
+            controller.calls += 1
+            controller._advance(t, dt)
