@@ -12,7 +12,7 @@ from __future__ import annotations
 
 __version__ = "0.1.0"
 
-from . import control, mass, rotation, shapes
+from . import actuators, control, mass, rotation, shapes
 from .errors import SimulationError
 from .handles import Body, Joint
 from .joints import BallJoint, DistanceJoint, FixedJoint, HingeJoint, SliderJoint
@@ -68,6 +68,7 @@ __all__ = [
     "TriMesh",
     "World",
     "__version__",
+    "actuators",
     "control",
     "load_scene",
     "mass",

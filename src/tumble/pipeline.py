@@ -21,13 +21,15 @@ Bodies with contacts (the soft step of DESIGN.md):
     update_sleep          manifolds, velocities  -> state.body_sleep_*     (dynamics/islands.py)
     to_angular_momentum   scratch.body_angvel    -> state.body_angmom      (dynamics/substep.py)
 
-Then, either way: advance time and the step count, and clear the applied loads.
+Actuators and drag act inside the integrators, from each stage's or substep's state (dynamics/actuation.py).
+Then, either way: advance time, the step count and the motors' speeds, and clear the applied loads.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
+from .dynamics.actuation import ActuatorArrays, advance_motors
 from .dynamics.contact_solver import apply_restitution, prepare_contacts
 from .dynamics.integrate import Recording, advance_free_bodies
 from .dynamics.islands import update_sleep, wake_touched
@@ -54,18 +56,26 @@ def simulate_steps(
     n_steps: int = 1,
     recording: Recording | None = None,
     record_every: int = 0,
+    acts: ActuatorArrays | None = None,
 ) -> tuple[int, int]:
-    """Advance ``n_steps`` steps of ``h``; returns ``(steps_done, failing_body)`` (-1 when all went well)."""
+    """Advance ``n_steps`` steps of ``h``; returns ``(steps_done, failing_body)`` (-1 when all went well).
+
+    ``acts`` are the actuators, drag and wind (none if ``None``); their motors' speeds advance with the steps.
+    """
+    if acts is None:
+        acts = ActuatorArrays.empty(model.body_count)
     if model.has_constraints:
         steps_done, failing_body = _contact_steps(
-            model, state, inputs, params, scratch, h, n_steps, recording, record_every
+            model, state, inputs, params, scratch, h, n_steps, recording, record_every, acts
         )
     else:
         method = params.resolve_integrator(False)
         steps_done, failing_body = advance_free_bodies(
-            model, state, inputs.body_force, inputs.body_torque, scratch, h, n_steps, method, recording, record_every
-        )
+            model, state, inputs.body_force, inputs.body_torque, acts, scratch, h, n_steps, method, recording,
+            record_every,
+        )  # fmt: skip
         _advance_clock(state, h, steps_done)
+        advance_motors(acts, steps_done * h)
     if steps_done > 0:
         inputs.clear()
     return steps_done, failing_body
@@ -80,7 +90,7 @@ def _advance_clock(state: State, h: float, steps: int) -> None:
     state.step_count += steps
 
 
-def _contact_steps(model, state, inputs, params, scratch, h, n_steps, recording, record_every) -> tuple[int, int]:
+def _contact_steps(model, state, inputs, params, scratch, h, n_steps, recording, record_every, acts):
     """Soft steps one after the other; on a non-finite value, restore the state before that step."""
     if params.resolve_integrator(True) != Integrator.SYMPLECTIC:
         raise ValueError(
@@ -92,7 +102,7 @@ def _contact_steps(model, state, inputs, params, scratch, h, n_steps, recording,
         before = state.copy()
         loads = inputs if step == 0 else zero  # applied loads act during the first step only
         try:
-            contact_step(model, state, loads, params, scratch, h)
+            contact_step(model, state, loads, params, scratch, h, acts)
             bad = _first_non_finite_body(state, model.body_is_dynamic, before)
         except (ZeroDivisionError, FloatingPointError):  # a kernel divided by an overflowed value
             bad = _fastest_body(before, model.body_is_dynamic)
@@ -100,6 +110,7 @@ def _contact_steps(model, state, inputs, params, scratch, h, n_steps, recording,
             state.assign(before)
             return step, bad
         _advance_clock(state, h, 1)
+        advance_motors(acts, h)
         if record_every > 0 and (step + 1) % record_every == 0:
             frame = (step + 1) // record_every - 1
             np.copyto(recording.pos[frame], state.body_pos)
@@ -134,7 +145,9 @@ def _fastest_body(state: State, is_dynamic: np.ndarray) -> int:
     return int(np.argmax(motion)) if motion.size else -1
 
 
-def contact_step(model: Model, state: State, inputs: Inputs, params: Params, scratch: Scratch, dt: float) -> None:
+def contact_step(
+    model: Model, state: State, inputs: Inputs, params: Params, scratch: Scratch, dt: float, acts: ActuatorArrays
+) -> None:
     """One soft step of ``dt`` (see the module docstring for the stages)."""
     settings = params.solver
     substeps = settings.substeps_for(dt)
@@ -243,6 +256,7 @@ def contact_step(model: Model, state: State, inputs: Inputs, params: Params, scr
         model.gravity,
         inputs.body_force,
         inputs.body_torque,
+        acts,
         rows,
         count,
         inv_inertia_world,

@@ -14,6 +14,7 @@ import numpy as np
 
 from . import diagnostics
 from ._validate import as_float, as_quaternion, as_vector3, mass_or_density
+from .actuators import Actuation, Actuator
 from .builder import ModelBuilder, ShapeSpec
 from .control import Controller, Controllers
 from .errors import SimulationError
@@ -200,6 +201,7 @@ class World:
         self._bodies: list[Body] = []
         self._joints: list[Joint] = []
         self._controllers = Controllers()
+        self._actuation = Actuation()
 
     # --- building -----------------------------------------------------------------------------------
 
@@ -315,6 +317,21 @@ class World:
         steps of ``dt`` (see ``tumble.control``). Returns a handle with ``.remove()``. A controller that raises
         stops ``step``/``simulate`` with a :class:`SimulationError` naming it and the time."""
         return self._controllers.add(callback, rate, name)
+
+    def add_actuator(self, actuator: Actuator) -> Actuator:
+        """Fix a :class:`~tumble.actuators.Rotor` or :class:`~tumble.actuators.Thruster` to its (dynamic) body;
+        returns it, now the handle through which it is commanded and read. Its loads act inside every step."""
+        return self._actuation.add(self, actuator)
+
+    @property
+    def actuators(self) -> list[Actuator]:
+        """The actuators, in the order added."""
+        return list(self._actuation.actuators)
+
+    def add_drag(self, body: Body, coefficients) -> None:
+        """Parasitic drag on ``body``: the force ``−c ⊙ |v_air| v_air`` at its COM, in its frame, with ``c =
+        coefficients`` (cx, cy, cz) [kg/m] and ``v_air`` its velocity relative to the wind. Again replaces."""
+        self._actuation.add_drag(self, body, coefficients)
 
     @property
     def controllers(self) -> list[Controller]:
@@ -478,9 +495,20 @@ class World:
         dt = as_float("dt", dt, positive=True)
         self._controllers.run(self, dt)
         self._sync()
-        steps_done, failing = simulate_steps(self._model, self._state, self._inputs, self._params, self._scratch, dt)
+        steps_done, failing = simulate_steps(self._model, self._state, self._inputs, self._params, self._scratch, dt,
+                                             acts=self._actuators_for_step())  # fmt: skip
         if failing >= 0:
             raise self._simulation_error(failing)
+
+    def _actuators_for_step(self):
+        """The actuators' arrays for the next steps; their bodies are kept awake (thrust that holds a body still
+        must not let it sleep, or a change of wind or command would not reach it)."""
+        acts = self._actuation.for_bodies(self._model.body_com_local)
+        driven = self._actuation.driven_bodies()
+        if driven.size:
+            self._state.body_sleep_time[driven] = 0.0
+            self._state.body_sleeping[driven] = False
+        return acts
 
     def simulate(self, duration: float, dt: float, record_every: int = 1) -> Trajectory:
         """Take ``round(duration / dt)`` steps in one compiled loop, recording every ``record_every`` steps.
@@ -512,6 +540,7 @@ class World:
                 n_steps,
                 recording,
                 int(record_every),
+                self._actuators_for_step(),
             )
         frames = steps_done // record_every
         trajectory = Trajectory.from_recording(
@@ -533,7 +562,8 @@ class World:
             self._sync()
             if self._state.body_count != recording.pos.shape[1]:
                 raise ValueError("a controller added bodies during simulate; add them before it, or between calls")
-            _, failing = simulate_steps(self._model, self._state, self._inputs, self._params, self._scratch, dt)
+            _, failing = simulate_steps(self._model, self._state, self._inputs, self._params, self._scratch, dt,
+                                        acts=self._actuators_for_step())  # fmt: skip
             if failing >= 0:
                 return step, failing, None
             if (step + 1) % record_every == 0:

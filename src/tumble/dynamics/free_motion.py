@@ -28,6 +28,10 @@ every step would not do (measured: 1e-11 relative drift over 20 000 steps from t
   Poisson integration of rigid body systems", J. Comput. Phys. 107; Hairer, Lubich & Wanner, "Geometric
   Numerical Integration", 2nd ed., sections IV.1 and VII.5).
 
+Each step also takes the loads of the body's actuators and drag (``actuation.py``) from the state at each of its
+stages and the time ``tau`` of the step's start within the call: at the start (Euler, semi-implicit Euler), at
+each stage (RK4), before and after the free flight (midpoint). They are zero for a body without any.
+
 Damping ``c`` is linear drag: implicit ``v / (1 + h c)`` (from ``exp(−c h)`` to first order) in the Euler
 schemes, exact-to-fourth-order inside RK4.
 """
@@ -52,13 +56,16 @@ from ..math3d import (
     sub,
     world_inertia_apply,
 )
+from .actuation import actuator_wrench
 
 
 @inline
-def euler_step(x, q, v, angmom, inv_m, inertia, inv_inertia, force, torque, c_lin, c_ang, h):
+def euler_step(x, q, v, angmom, inv_m, inertia, inv_inertia, force, torque, c_lin, c_ang, h, acts, i, tau):
     """Explicit Euler (course 003): positions from the old velocities, then momenta."""
+    w = world_inertia_apply(q, inv_inertia, angmom)
+    force, torque = _with_actuators(force, torque, acts, i, tau, q, v, w)
     x_new = add_scaled(x, v, h)
-    q_new = quat_integrate(q, world_inertia_apply(q, inv_inertia, angmom), h)
+    q_new = quat_integrate(q, w, h)
     v_new = scale(add_scaled(v, force, h * inv_m), 1.0 / (1.0 + h * c_lin))
     l_new = scale(add_scaled(angmom, torque, h), 1.0 / (1.0 + h * c_ang))
     return x_new, q_new, v_new, l_new
@@ -100,8 +107,9 @@ def implicit_spin(q, w_body, inertia, torque, c_ang, h):
 
 
 @inline
-def symplectic_step(x, q, v, angmom, inv_m, inertia, inv_inertia, force, torque, c_lin, c_ang, h):
+def symplectic_step(x, q, v, angmom, inv_m, inertia, inv_inertia, force, torque, c_lin, c_ang, h, acts, i, tau):
     """Semi-implicit Euler; body-frame ``I(ω'−ω)/h + ω'×Iω' = τ`` solved by one Newton step from ``ω``."""
+    force, torque = _with_actuators(force, torque, acts, i, tau, q, v, world_inertia_apply(q, inv_inertia, angmom))
     v_new = scale(add_scaled(v, force, h * inv_m), 1.0 / (1.0 + h * c_lin))
     w_body = implicit_spin(q, mat_vec(inv_inertia, quat_rotate_inv(q, angmom)), inertia, torque, c_ang, h)
     x_new = add_scaled(x, v_new, h)
@@ -118,30 +126,36 @@ def _angvel_from_momentum(q, inv_inertia, angmom):
 
 
 @inline
-def rk4_step(x, q, v, angmom, inv_m, inertia, inv_inertia, force, torque, c_lin, c_ang, h):
-    """Classical RK4 on ``(x, q, v, L)`` with constant ``F`` and ``τ``."""
-    accel = scale(force, inv_m)
+def _with_actuators(force, torque, acts, i, tau, q, v, w):
+    """The constant loads plus the actuators' and drag's at this state and time."""
+    f, t = actuator_wrench(acts, i, tau, q, v, w)
+    return add(force, f), add(torque, t)
+
+
+@inline
+def _rk4_rates(q, v, angmom, inv_m, inv_inertia, force, torque, c_lin, c_ang, acts, i, tau):
+    """``(q̇, v̇, L̇)`` of one RK4 stage."""
+    w = _angvel_from_momentum(q, inv_inertia, angmom)
+    force, torque = _with_actuators(force, torque, acts, i, tau, quat_normalize(q), v, w)
+    return quat_derivative(q, w), add_scaled(scale(force, inv_m), v, -c_lin), add_scaled(torque, angmom, -c_ang)
+
+
+@inline
+def rk4_step(x, q, v, angmom, inv_m, inertia, inv_inertia, force, torque, c_lin, c_ang, h, acts, i, tau):
+    """Classical RK4 on ``(x, q, v, L)`` with constant ``F`` and ``τ`` plus the actuators' at each stage."""
     half = 0.5 * h
-    # Stage 1 at (x, q, v, L); ẋ = v, q̇ = ½ ω ⊗ q, v̇ = a − c v, L̇ = τ − c L.
+    # Stage 1 at (x, q, v, L); ẋ = v, q̇ = ½ ω ⊗ q, v̇ = F/m − c v, L̇ = τ − c L.
     q1, v1, l1 = q, v, angmom
-    dq1 = quat_derivative(q1, _angvel_from_momentum(q1, inv_inertia, l1))
-    dv1 = add_scaled(accel, v1, -c_lin)
-    dl1 = add_scaled(torque, l1, -c_ang)
+    dq1, dv1, dl1 = _rk4_rates(q1, v1, l1, inv_m, inv_inertia, force, torque, c_lin, c_ang, acts, i, tau)
     # Stage 2 at y + h/2 k1.
     q2, v2, l2 = quat_add_scaled(q, dq1, half), add_scaled(v, dv1, half), add_scaled(angmom, dl1, half)
-    dq2 = quat_derivative(q2, _angvel_from_momentum(q2, inv_inertia, l2))
-    dv2 = add_scaled(accel, v2, -c_lin)
-    dl2 = add_scaled(torque, l2, -c_ang)
+    dq2, dv2, dl2 = _rk4_rates(q2, v2, l2, inv_m, inv_inertia, force, torque, c_lin, c_ang, acts, i, tau + half)
     # Stage 3 at y + h/2 k2.
     q3, v3, l3 = quat_add_scaled(q, dq2, half), add_scaled(v, dv2, half), add_scaled(angmom, dl2, half)
-    dq3 = quat_derivative(q3, _angvel_from_momentum(q3, inv_inertia, l3))
-    dv3 = add_scaled(accel, v3, -c_lin)
-    dl3 = add_scaled(torque, l3, -c_ang)
+    dq3, dv3, dl3 = _rk4_rates(q3, v3, l3, inv_m, inv_inertia, force, torque, c_lin, c_ang, acts, i, tau + half)
     # Stage 4 at y + h k3.
     q4, v4, l4 = quat_add_scaled(q, dq3, h), add_scaled(v, dv3, h), add_scaled(angmom, dl3, h)
-    dq4 = quat_derivative(q4, _angvel_from_momentum(q4, inv_inertia, l4))
-    dv4 = add_scaled(accel, v4, -c_lin)
-    dl4 = add_scaled(torque, l4, -c_ang)
+    dq4, dv4, dl4 = _rk4_rates(q4, v4, l4, inv_m, inv_inertia, force, torque, c_lin, c_ang, acts, i, tau + h)
     # Combine: y + h/6 (k1 + 2 k2 + 2 k3 + k4); ẋ's stages are the v's.
     sixth = h / 6.0
     x_new = add_scaled(x, add(add(v1, v4), scale(add(v2, v3), 2.0)), sixth)
@@ -183,19 +197,22 @@ def _midpoint_momentum(pi, inertia_inv, h):
 
 
 @inline
-def midpoint_step(x, q, v, angmom, inv_m, inertia, inv_inertia, force, torque, c_lin, c_ang, h):
+def midpoint_step(x, q, v, angmom, inv_m, inertia, inv_inertia, force, torque, c_lin, c_ang, h, acts, i, tau):
     """Strang splitting: half kick, free flight (exact translation, Lie–Poisson midpoint rotation), half kick."""
     half = 0.5 * h
     # Half kick: v += h/2 (a − c v), L += h/2 (τ − c L), the damping implicit.
-    v_half = scale(add_scaled(v, force, half * inv_m), 1.0 / (1.0 + half * c_lin))
-    l_half = scale(add_scaled(angmom, torque, half), 1.0 / (1.0 + half * c_ang))
+    f0, t0 = _with_actuators(force, torque, acts, i, tau, q, v, world_inertia_apply(q, inv_inertia, angmom))
+    v_half = scale(add_scaled(v, f0, half * inv_m), 1.0 / (1.0 + half * c_lin))
+    l_half = scale(add_scaled(angmom, t0, half), 1.0 / (1.0 + half * c_ang))
     # Free flight: straight line; rotation by the Cayley map of h Ω_m in the body frame, L unchanged.
     x_new = add_scaled(x, v_half, h)
     pm = _midpoint_momentum(quat_rotate_inv(q, l_half), inv_inertia, h)
     w = mat_vec(inv_inertia, pm)
     # cay(h Ω̂) is the rotation of the quaternion (1, h Ω / 2), normalised (tan(θ/2) = h|Ω|/2).
     q_new = quat_normalize(quat_mul(q, (1.0, half * w[0], half * w[1], half * w[2])))
-    # Second half kick.
-    v_new = scale(add_scaled(v_half, force, half * inv_m), 1.0 / (1.0 + half * c_lin))
-    l_new = scale(add_scaled(l_half, torque, half), 1.0 / (1.0 + half * c_ang))
+    # Second half kick, with the actuators' loads after the flight.
+    f1, t1 = _with_actuators(force, torque, acts, i, tau + h, q_new, v_half,
+                             world_inertia_apply(q_new, inv_inertia, l_half))  # fmt: skip
+    v_new = scale(add_scaled(v_half, f1, half * inv_m), 1.0 / (1.0 + half * c_lin))
+    l_new = scale(add_scaled(l_half, t1, half), 1.0 / (1.0 + half * c_ang))
     return x_new, q_new, v_new, l_new

@@ -53,7 +53,7 @@ def empty_recording(body_count: int) -> Recording:
 
 
 @kernel
-def _advance_body(i, bodies, gravity, force, torque, pos, quat, linvel, angmom, rec, h, n_steps, method,
+def _advance_body(i, bodies, gravity, force, torque, acts, pos, quat, linvel, angmom, rec, h, n_steps, method,
                   record_every):  # fmt: skip
     """Carry body ``i`` through ``n_steps``; return the index of the failing step, or -1.
 
@@ -79,13 +79,17 @@ def _advance_body(i, bodies, gravity, force, torque, pos, quat, linvel, angmom, 
             f = weight
             t = steady_torque
         if method == 0:
-            xn, qn, vn, ln = euler_step(x, q, v, l, inv_m, inertia, inv_inertia, f, t, c_lin, c_ang, h)
+            xn, qn, vn, ln = euler_step(x, q, v, l, inv_m, inertia, inv_inertia, f, t, c_lin, c_ang, h, acts, i, s * h)
         elif method == 1:
-            xn, qn, vn, ln = symplectic_step(x, q, v, l, inv_m, inertia, inv_inertia, f, t, c_lin, c_ang, h)
+            xn, qn, vn, ln = symplectic_step(
+                x, q, v, l, inv_m, inertia, inv_inertia, f, t, c_lin, c_ang, h, acts, i, s * h
+            )
         elif method == 2:
-            xn, qn, vn, ln = rk4_step(x, q, v, l, inv_m, inertia, inv_inertia, f, t, c_lin, c_ang, h)
+            xn, qn, vn, ln = rk4_step(x, q, v, l, inv_m, inertia, inv_inertia, f, t, c_lin, c_ang, h, acts, i, s * h)
         else:
-            xn, qn, vn, ln = midpoint_step(x, q, v, l, inv_m, inertia, inv_inertia, f, t, c_lin, c_ang, h)
+            xn, qn, vn, ln = midpoint_step(
+                x, q, v, l, inv_m, inertia, inv_inertia, f, t, c_lin, c_ang, h, acts, i, s * h
+            )
         if not (is_finite3(xn) and quat_is_finite(qn) and is_finite3(vn) and is_finite3(ln)):
             failed = s
             break
@@ -115,8 +119,8 @@ def _copy_static_rows(i, pos, quat, linvel, angmom, rec, n_steps, record_every):
 
 
 @kernel
-def _advance_rows_kernel(bodies, gravity, force, torque, pos, quat, linvel, angmom, backup, rec, failed_step, h,
-                         n_steps, method, record_every, first, last):  # fmt: skip
+def _advance_rows_kernel(bodies, gravity, force, torque, acts, pos, quat, linvel, angmom, backup, rec, failed_step,
+                         h, n_steps, method, record_every, first, last):  # fmt: skip
     """Bodies ``first..last-1``; returns their first failing step, or -1. Releases the GIL (``nogil``).
 
     ``backup`` receives each row before it moves; ``failed_step[i]`` the failing step of body ``i`` or -1.
@@ -125,7 +129,7 @@ def _advance_rows_kernel(bodies, gravity, force, torque, pos, quat, linvel, angm
         _save_row(i, pos, quat, linvel, angmom, backup)
         failed_step[i] = -1
         if bodies.is_dynamic[i]:
-            failed_step[i] = _advance_body(i, bodies, gravity, force, torque, pos, quat, linvel, angmom, rec,
+            failed_step[i] = _advance_body(i, bodies, gravity, force, torque, acts, pos, quat, linvel, angmom, rec,
                                            h, n_steps, method, record_every)  # fmt: skip
         else:
             _copy_static_rows(i, pos, quat, linvel, angmom, rec, n_steps, record_every)
@@ -171,6 +175,7 @@ def advance_free_bodies(
     state: State,
     body_force: np.ndarray,
     body_torque: np.ndarray,
+    acts,
     scratch,
     h: float,
     n_steps: int,
@@ -180,7 +185,9 @@ def advance_free_bodies(
 ) -> tuple[int, int]:
     """Integrate every dynamic body for ``n_steps`` steps of ``h``.
 
-    Reads: model.body_*, model.gravity, body_force, body_torque (applied during the first step only).
+    Reads: model.body_*, model.gravity, body_force, body_torque (applied during the first step only), the
+    actuators ``acts`` (:class:`~tumble.dynamics.actuation.ActuatorArrays`: their loads at every stage, the motors'
+    speeds at the start of the call; the caller advances the motors after it).
     Writes: state.body_pos/quat/linvel/angmom, ``recording`` (one frame every ``record_every`` steps),
     scratch.backup_* and scratch.failed_step.
 
@@ -193,8 +200,8 @@ def advance_free_bodies(
     if recording is None:
         recording, record_every = scratch.no_recording, 0
     arrays = (state.body_pos, state.body_quat, state.body_linvel, state.body_angmom)
-    args = (bodies, model.gravity, body_force, body_torque, *arrays, scratch.backup, recording, scratch.failed_step,
-            h, n_steps, int(method), record_every)  # fmt: skip
+    args = (bodies, model.gravity, body_force, body_torque, acts, *arrays, scratch.backup, recording,
+            scratch.failed_step, h, n_steps, int(method), record_every)  # fmt: skip
     first_failure = _run_rows(args, model.body_count, model.body_count * n_steps)
     if first_failure < 0:
         return n_steps, -1

@@ -23,6 +23,7 @@ from ..math3d import (
     store4,
     world_inertia_apply,
 )
+from .actuation import actuator_wrench
 from .contact_solver import accumulate_impulses, resolve_impacts, solve_contacts, warm_start_contacts
 from .free_motion import implicit_spin
 from .joint_solver import solve_joints, warm_start_joints
@@ -57,19 +58,21 @@ def to_angular_momentum(bodies, quat, angvel, angmom):
 
 
 @kernel
-def integrate_velocities(bodies, moving, gravity, force, torque, quat, linvel, angvel, h):
-    """``v += h (g + F/m)``, implicit gyroscopic spin update, implicit damping; moving (awake dynamic) bodies."""
+def integrate_velocities(bodies, moving, gravity, force, torque, acts, tau, quat, linvel, angvel, h):
+    """``v += h (g + F/m)``, implicit gyroscopic spin update, implicit damping; moving (awake dynamic) bodies. The
+    actuators' and drag's loads are those of the substep's start state, ``tau`` into the step."""
     for i in range(quat.shape[0]):
         if not moving[i]:
             continue
-        applied = add(load3(force, i), load3(bodies.constant_force, i))
+        q = load4(quat, i)
+        driven_force, driven_torque = actuator_wrench(acts, i, tau, q, load3(linvel, i), load3(angvel, i))
+        applied = add(add(load3(force, i), load3(bodies.constant_force, i)), driven_force)
         accel = add_scaled((gravity[0], gravity[1], gravity[2]), applied, bodies.inv_mass[i])
         v = scale(add_scaled(load3(linvel, i), accel, h), 1.0 / (1.0 + h * bodies.linear_damping[i]))
         store3(linvel, i, v)
-        q = load4(quat, i)
         w_body = quat_rotate_inv(q, load3(angvel, i))
         inertia = load33(bodies.inertia_local, i)
-        spin = add(load3(torque, i), load3(bodies.constant_torque, i))
+        spin = add(add(load3(torque, i), load3(bodies.constant_torque, i)), driven_torque)
         w_body = implicit_spin(q, w_body, inertia, spin, bodies.angular_damping[i], h)
         store3(angvel, i, quat_rotate(q, w_body))
 
@@ -85,8 +88,8 @@ def integrate_positions(moving, linvel, angvel, pos, quat, h):
 
 @kernel
 def run_substeps(
-    bodies, moving, inv_mass, gravity, force, torque, rows, count, inv_inertia_world, pos, quat, pos0, quat0, linvel,
-    angvel, h, substeps, push_max, threshold, joints, joint_impulses, joint_hertz, joint_damping_ratio,
+    bodies, moving, inv_mass, gravity, force, torque, acts, rows, count, inv_inertia_world, pos, quat, pos0, quat0,
+    linvel, angvel, h, substeps, push_max, threshold, joints, joint_impulses, joint_hertz, joint_damping_ratio,
     joint_force_total, joint_moment_total,
 ):  # fmt: skip
     """The soft step's inner loop (Catto 2024): per substep integrate velocities, bounce the ball impacts of the
@@ -94,8 +97,8 @@ def run_substeps(
     ``inv_mass`` and ``inv_inertia_world`` are zero for bodies that do not move (static or sleeping), which the
     solver then treats as fixed."""
     inv_h = 1.0 / h
-    for _ in range(substeps):
-        integrate_velocities(bodies, moving, gravity, force, torque, quat, linvel, angvel, h)
+    for k in range(substeps):
+        integrate_velocities(bodies, moving, gravity, force, torque, acts, k * h, quat, linvel, angvel, h)
         resolve_impacts(rows, count, inv_mass, inv_inertia_world, pos, quat, pos0, quat0, linvel, angvel, h, threshold,
                         gravity, force, bodies.constant_force)  # fmt: skip
         warm_start_joints(joints, joint_impulses, inv_mass, inv_inertia_world, pos, quat, linvel, angvel,
