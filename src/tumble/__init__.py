@@ -12,7 +12,7 @@ from __future__ import annotations
 
 __version__ = "0.1.0"
 
-from . import actuators, control, mass, rotation, shapes
+from . import actuators, control, mass, rotation, sensors, shapes
 from .errors import SimulationError
 from .handles import Body, Joint
 from .joints import BallJoint, DistanceJoint, FixedJoint, HingeJoint, SliderJoint
@@ -73,5 +73,6 @@ __all__ = [
     "load_scene",
     "mass",
     "rotation",
+    "sensors",
     "shapes",
 ]

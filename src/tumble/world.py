@@ -27,6 +27,7 @@ from .pipeline import simulate_steps
 from .queries import Contacts, RayHit
 from .rotation import quat_rotate
 from .scratch import Scratch
+from .sensors import Sensor
 from .shapes import Plane, Shape, TriMesh
 from .state import State
 from .trajectory import Trajectory
@@ -202,6 +203,7 @@ class World:
         self._joints: list[Joint] = []
         self._controllers = Controllers()
         self._actuation = Actuation()
+        self._sensors: list[Sensor] = []
 
     # --- building -----------------------------------------------------------------------------------
 
@@ -332,6 +334,20 @@ class World:
         """Parasitic drag on ``body``: the force ``−c ⊙ |v_air| v_air`` at its COM, in its frame, with ``c =
         coefficients`` (cx, cy, cz) [kg/m] and ``v_air`` its velocity relative to the wind. Again replaces."""
         self._actuation.add_drag(self, body, coefficients)
+
+    def add_sensor(self, sensor: Sensor) -> Sensor:
+        """Add a :class:`~tumble.sensors.IMU` or :class:`~tumble.sensors.Pose`; returns it, to ``read()``. It samples
+        at the end of every step."""
+        if not isinstance(sensor, Sensor):
+            raise TypeError(f"sensor must be a tumble.sensors.IMU or Pose, got {sensor!r}")
+        sensor._attach(self)
+        self._sensors.append(sensor)
+        return sensor
+
+    @property
+    def sensors(self) -> list[Sensor]:
+        """The sensors, in the order added."""
+        return list(self._sensors)
 
     @property
     def controllers(self) -> list[Controller]:
@@ -495,10 +511,14 @@ class World:
         dt = as_float("dt", dt, positive=True)
         self._controllers.run(self, dt)
         self._sync()
+        for sensor in self._sensors:
+            sensor._before_step()
         steps_done, failing = simulate_steps(self._model, self._state, self._inputs, self._params, self._scratch, dt,
                                              acts=self._actuators_for_step())  # fmt: skip
         if failing >= 0:
             raise self._simulation_error(failing)
+        for sensor in self._sensors:
+            sensor._sample(dt)
 
     def _actuators_for_step(self):
         """The actuators' arrays for the next steps; their bodies are kept awake (thrust that holds a body still
@@ -527,7 +547,7 @@ class World:
         t0, initial = self._state.time, self._state.copy()
         recording = Trajectory.allocate_recording(self._state.body_count, n_steps // record_every)
         controller_error = None
-        if self._controllers:
+        if self._controllers or self._sensors:
             steps_done, failing, controller_error = self._simulate_stepwise(dt, n_steps, recording, int(record_every))
         else:
             steps_done, failing = simulate_steps(
@@ -553,7 +573,8 @@ class World:
         return trajectory
 
     def _simulate_stepwise(self, dt: float, n_steps: int, recording, record_every: int):
-        """Step by step from Python, the controllers before each step: ``(steps_done, failing_body, error)``."""
+        """Step by step from Python, the controllers before each step and the sensors after it: ``(steps_done,
+        failing_body, error)``."""
         for step in range(n_steps):
             try:
                 self._controllers.run(self, dt)
@@ -562,10 +583,14 @@ class World:
             self._sync()
             if self._state.body_count != recording.pos.shape[1]:
                 raise ValueError("a controller added bodies during simulate; add them before it, or between calls")
+            for sensor in self._sensors:
+                sensor._before_step()
             _, failing = simulate_steps(self._model, self._state, self._inputs, self._params, self._scratch, dt,
                                         acts=self._actuators_for_step())  # fmt: skip
             if failing >= 0:
                 return step, failing, None
+            for sensor in self._sensors:
+                sensor._sample(dt)
             if (step + 1) % record_every == 0:
                 frame = (step + 1) // record_every - 1
                 for name in ("pos", "quat", "linvel", "angmom"):
