@@ -31,6 +31,7 @@ from .sensors import Sensor
 from .shapes import Plane, Shape, TriMesh
 from .state import State
 from .trajectory import Trajectory
+from .wind import Constant, Wind, as_wind
 
 __all__ = ["World"]
 
@@ -204,6 +205,7 @@ class World:
         self._controllers = Controllers()
         self._actuation = Actuation()
         self._sensors: list[Sensor] = []
+        self._wind: Wind | None = None
 
     # --- building -----------------------------------------------------------------------------------
 
@@ -348,6 +350,17 @@ class World:
     def sensors(self) -> list[Sensor]:
         """The sensors, in the order added."""
         return list(self._sensors)
+
+    @property
+    def wind(self) -> Wind | None:
+        """The air's velocity that rotors and drag see: ``None`` (still air, the default), a
+        :class:`~tumble.wind.Constant`, :class:`~tumble.wind.Sinusoid` or :class:`~tumble.wind.Dryden` model, or
+        a 3-vector (a constant wind) [m/s]."""
+        return self._wind
+
+    @wind.setter
+    def wind(self, value) -> None:
+        self._wind = as_wind(value)
 
     @property
     def controllers(self) -> list[Controller]:
@@ -514,15 +527,20 @@ class World:
         for sensor in self._sensors:
             sensor._before_step()
         steps_done, failing = simulate_steps(self._model, self._state, self._inputs, self._params, self._scratch, dt,
-                                             acts=self._actuators_for_step())  # fmt: skip
+                                             acts=self._actuators_for_step(dt))  # fmt: skip
         if failing >= 0:
             raise self._simulation_error(failing)
         for sensor in self._sensors:
             sensor._sample(dt)
 
-    def _actuators_for_step(self):
-        """The actuators' arrays for the next steps; their bodies are kept awake (thrust that holds a body still
-        must not let it sleep, or a change of wind or command would not reach it)."""
+    def _actuators_for_step(self, dt: float):
+        """The actuators' arrays and the wind for the next steps; their bodies are kept awake (thrust that holds a
+        body still must not let it sleep, or a change of wind or command would not reach it)."""
+        if self._wind is not None:
+            t = self._controllers.time(self._state.time, self._state.step_count, dt)
+            self._actuation.wind = self._wind.velocity(t, dt)
+        else:
+            self._actuation.wind = np.zeros(3)
         acts = self._actuation.for_bodies(self._model.body_com_local)
         driven = self._actuation.driven_bodies()
         if driven.size:
@@ -547,7 +565,7 @@ class World:
         t0, initial = self._state.time, self._state.copy()
         recording = Trajectory.allocate_recording(self._state.body_count, n_steps // record_every)
         controller_error = None
-        if self._controllers or self._sensors:
+        if self._controllers or self._sensors or not isinstance(self._wind, (Constant, type(None))):
             steps_done, failing, controller_error = self._simulate_stepwise(dt, n_steps, recording, int(record_every))
         else:
             steps_done, failing = simulate_steps(
@@ -560,7 +578,7 @@ class World:
                 n_steps,
                 recording,
                 int(record_every),
-                self._actuators_for_step(),
+                self._actuators_for_step(dt),
             )
         frames = steps_done // record_every
         trajectory = Trajectory.from_recording(
@@ -586,7 +604,7 @@ class World:
             for sensor in self._sensors:
                 sensor._before_step()
             _, failing = simulate_steps(self._model, self._state, self._inputs, self._params, self._scratch, dt,
-                                        acts=self._actuators_for_step())  # fmt: skip
+                                        acts=self._actuators_for_step(dt))  # fmt: skip
             if failing >= 0:
                 return step, failing, None
             for sensor in self._sensors:
