@@ -109,3 +109,30 @@ def mass_or_density(mass, density) -> tuple[str, float]:
     if mass is not None:
         return "mass", as_float("mass", mass, positive=True)
     return "density", as_float("density", density, positive=True)
+
+
+def as_seed(value) -> int | None:
+    """A seed for ``numpy.random.default_rng``: an integer >= 0, or ``None`` for a fresh one."""
+    if value is not None and (isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 0):
+        raise ValueError(f"seed must be an integer >= 0 or None, got {value!r}")
+    return None if value is None else int(value)
+
+
+def as_body(value):
+    """A body handle (``world.add_body``'s answer)."""
+    from .handles import Body
+
+    if not isinstance(value, Body):
+        raise TypeError(f"body must be a tumble.Body (from world.add_body), got {value!r}")
+    return value
+
+
+def as_dynamic_body_of(world, value, what: str):
+    """A body of ``world`` that moves, for ``what`` (an actuator, a sensor, drag) to act on or read."""
+    body = as_body(value)
+    name = body.name or body.index
+    if body._world is not world:
+        raise ValueError(f"body {name!r} belongs to another world; {what} needs a body of this one")
+    if body.is_static:
+        raise ValueError(f"body {name!r} is static: {what} needs a dynamic body")
+    return body

@@ -20,7 +20,7 @@ import math
 
 import numpy as np
 
-from ._validate import as_float, as_unit_vector3, as_vector3
+from ._validate import as_body, as_dynamic_body_of, as_float, as_unit_vector3, as_vector3
 from .dynamics.actuation import ROTOR, THRUSTER, ActuatorArrays
 
 __all__ = ["Actuator", "Rotor", "Thruster"]
@@ -32,11 +32,7 @@ class Actuator:
     _kind = -1
 
     def __init__(self, body, position, axis, axis_name: str):
-        from .handles import Body
-
-        if not isinstance(body, Body):
-            raise TypeError(f"body must be a tumble.Body (from world.add_body), got {body!r}")
-        self.body = body
+        self.body = as_body(body)
         self.position = as_vector3("position", position)
         self.axis = as_unit_vector3(axis_name, axis)
         self._world = None
@@ -175,7 +171,7 @@ class Actuation:
             raise TypeError(f"actuator must be a tumble.actuators.Rotor or Thruster, got {actuator!r}")
         if actuator._world is not None:
             raise ValueError(f"{actuator!r} is in a world already")
-        _check_body(world, actuator.body, "an actuator")
+        as_dynamic_body_of(world, actuator.body, "an actuator")
         self._pack_current()
         actuator._world = world
         self.actuators.append(actuator)
@@ -183,7 +179,7 @@ class Actuation:
         return actuator
 
     def add_drag(self, world, body, coefficients) -> None:
-        _check_body(world, body, "drag")
+        as_dynamic_body_of(world, body, "drag")
         c = as_vector3("coefficients", coefficients)
         if (c < 0).any():
             raise ValueError(f"coefficients must be >= 0, got {c.tolist()}")
@@ -243,16 +239,3 @@ class Actuation:
             actuator._owner, actuator._row = self, row
         self._body_count = body_count
         return arrays
-
-
-def _check_body(world, body, what: str) -> None:
-    from .handles import Body
-
-    if not isinstance(body, Body):
-        raise TypeError(f"body must be a tumble.Body (from world.add_body), got {body!r}")
-    if body._world is not world:
-        raise ValueError(
-            f"body {body.name or body.index!r} belongs to another world; {what} acts on a body of this one"
-        )
-    if body.is_static:
-        raise ValueError(f"body {body.name or body.index!r} is static: {what} needs a dynamic body")

@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._validate import as_float, as_vector3
+from ._validate import as_body, as_dynamic_body_of, as_float, as_seed, as_vector3
 from .rotation import quat_from_rotvec, quat_multiply, quat_to_matrix
 
 __all__ = ["IMU", "Pose", "Sensor"]
@@ -30,25 +30,15 @@ class Sensor:
     """What every sensor shares: its body, its generator, its link to a world."""
 
     def __init__(self, body, seed):
-        from .handles import Body
-
-        if not isinstance(body, Body):
-            raise TypeError(f"body must be a tumble.Body (from world.add_body), got {body!r}")
-        if seed is not None and (isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0):
-            raise ValueError(f"seed must be an integer >= 0 or None, got {seed!r}")
-        self.body = body
-        self.seed = seed
+        self.body = as_body(body)
+        self.seed = as_seed(seed)
         self._rng = np.random.default_rng(seed)
         self._world = None
 
     def _attach(self, world) -> None:
         if self._world is not None:
             raise ValueError(f"{self!r} is in a world already")
-        if self.body._world is not world:
-            name = self.body.name or self.body.index
-            raise ValueError(f"body {name!r} belongs to another world; a sensor reads a body of this one")
-        if self.body.is_static:
-            raise ValueError(f"body {self.body.name or self.body.index!r} is static: a sensor needs a dynamic body")
+        as_dynamic_body_of(world, self.body, "a sensor")
         self._world = world
         self._reset()
 

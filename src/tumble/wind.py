@@ -21,7 +21,7 @@ import math
 import numpy as np
 from scipy.linalg import expm, solve_continuous_lyapunov
 
-from ._validate import as_float, as_vector3
+from ._validate import as_float, as_seed, as_vector3
 
 __all__ = ["Constant", "Dryden", "Sinusoid", "Wind"]
 
@@ -92,9 +92,7 @@ class Dryden(Wind):
             )
         self.sigma = _three("sigma", sigma)
         self.length_scale = _three("length_scale", length_scale)
-        if seed is not None and (isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0):
-            raise ValueError(f"seed must be an integer >= 0 or None, got {seed!r}")
-        self.seed = seed
+        self.seed = as_seed(seed)
         self.correlation_time = self.length_scale / speed
         # The wind frame: u along the mean wind, w as near world up as can be, v = w × u.
         u = self.mean / speed

@@ -149,7 +149,7 @@ def test_sensors_need_a_dynamic_body_of_this_world():
     world, body = box_world()
     ground = world.add_static(tumble.Plane(), name="ground")
     _, other = box_world()
-    with pytest.raises(ValueError, match="belongs to another world; a sensor reads a body of this one"):
+    with pytest.raises(ValueError, match="belongs to another world; a sensor needs a body of this one"):
         world.add_sensor(IMU(other))
     with pytest.raises(ValueError, match="body 'ground' is static: a sensor needs a dynamic body"):
         world.add_sensor(Pose(ground))
