@@ -232,9 +232,11 @@ class Actuation:
         axis = np.array([a.axis for a in ordered], float).reshape(-1, 3)
         speed = np.array([a._speed for a in ordered], float)
         command = np.array([a._command for a in ordered], float)
-        arrays = ActuatorArrays(first, kind, position, axis, *(parameters[:, k].copy() for k in range(6)), speed,
-                                command, drag, self.wind.copy())  # fmt: skip
         self._driven = np.array(sorted({a.body.index for a in ordered} | set(self.drag)), np.int64)
+        driven = np.zeros(body_count, np.bool_)
+        driven[self._driven] = True
+        arrays = ActuatorArrays(first, kind, position, axis, *(parameters[:, k].copy() for k in range(6)), speed,
+                                command, drag, driven, self.wind.copy())  # fmt: skip
         for row, actuator in enumerate(ordered):
             actuator._owner, actuator._row = self, row
         self._body_count = body_count

@@ -48,6 +48,7 @@ class ActuatorArrays(NamedTuple):
     speed: np.ndarray  # (a,) the motor's speed [rad/s] (a thruster's force [N]) at the start of the call
     command: np.ndarray  # (a,) the commanded speed (force), already within limits
     drag: np.ndarray  # (n, 3) parasitic drag coefficients [kg/m]
+    driven: np.ndarray  # (n,) bool: the body has actuators or drag (read in the kernels' loops, not through calls)
     wind: np.ndarray  # (3,) the air's velocity during the call, world frame [m/s]
 
     @classmethod
@@ -55,7 +56,7 @@ class ActuatorArrays(NamedTuple):
         none = np.zeros(0)
         return cls(np.zeros(body_count + 1, np.int64), np.zeros(0, np.int64), np.zeros((0, 3)), np.zeros((0, 3)),
                    none, none, none, none, none, none, np.zeros(0), np.zeros(0), np.zeros((body_count, 3)),
-                   np.zeros(3))  # fmt: skip
+                   np.zeros(body_count, np.bool_), np.zeros(3))  # fmt: skip
 
 
 @inline
@@ -72,8 +73,6 @@ def actuator_wrench(acts, i, tau, q, v, w):
     call, for orientation ``q``, COM velocity ``v`` and angular velocity ``w`` (world frame)."""
     zero = (0.0, 0.0, 0.0)
     has_drag = acts.drag[i, 0] != 0.0 or acts.drag[i, 1] != 0.0 or acts.drag[i, 2] != 0.0
-    if acts.first[i] == acts.first[i + 1] and not has_drag:
-        return zero, zero
     v_body = quat_rotate_inv(q, v)
     w_body = quat_rotate_inv(q, w)
     air = sub(v_body, quat_rotate_inv(q, (acts.wind[0], acts.wind[1], acts.wind[2])))

@@ -127,8 +127,12 @@ def _angvel_from_momentum(q, inv_inertia, angmom):
 
 @inline
 def _with_actuators(force, torque, acts, i, tau, q, v, w):
-    """The constant loads plus the actuators' and drag's at this state and time."""
-    f, t = actuator_wrench(acts, i, tau, q, v, w)
+    """The constant loads plus the actuators' and drag's at this state and time (``q`` need not be normalised).
+    ``acts`` is ``None`` for a body without any: Numba then compiles this to nothing (a branch on ``None`` is
+    pruned at compile time), so free bodies run as fast as before actuators existed."""
+    if acts is None:
+        return force, torque
+    f, t = actuator_wrench(acts, i, tau, quat_normalize(q), v, w)
     return add(force, f), add(torque, t)
 
 
@@ -136,7 +140,7 @@ def _with_actuators(force, torque, acts, i, tau, q, v, w):
 def _rk4_rates(q, v, angmom, inv_m, inv_inertia, force, torque, c_lin, c_ang, acts, i, tau):
     """``(q̇, v̇, L̇)`` of one RK4 stage."""
     w = _angvel_from_momentum(q, inv_inertia, angmom)
-    force, torque = _with_actuators(force, torque, acts, i, tau, quat_normalize(q), v, w)
+    force, torque = _with_actuators(force, torque, acts, i, tau, q, v, w)
     return quat_derivative(q, w), add_scaled(scale(force, inv_m), v, -c_lin), add_scaled(torque, angmom, -c_ang)
 
 

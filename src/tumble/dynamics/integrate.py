@@ -57,8 +57,20 @@ def _advance_body(i, bodies, gravity, force, torque, acts, pos, quat, linvel, an
                   record_every):  # fmt: skip
     """Carry body ``i`` through ``n_steps``; return the index of the failing step, or -1.
 
-    A compiled function of its own (not inlined), so the row loop stays small to compile.
+    A compiled function of its own (not inlined), so the row loop stays small to compile. A body without
+    actuators runs the steps compiled with ``acts=None``, in which they cost nothing.
     """
+    if acts.driven[i]:
+        return _body_steps(i, bodies, gravity, force, torque, acts, pos, quat, linvel, angmom, rec, h, n_steps,
+                           method, record_every)  # fmt: skip
+    return _body_steps(i, bodies, gravity, force, torque, None, pos, quat, linvel, angmom, rec, h, n_steps, method,
+                       record_every)  # fmt: skip
+
+
+@kernel
+def _body_steps(i, bodies, gravity, force, torque, acts, pos, quat, linvel, angmom, rec, h, n_steps, method,
+                record_every):  # fmt: skip
+    """The steps of :func:`_advance_body`, with its actuators ``acts`` or ``None``."""
     inv_m = bodies.inv_mass[i]
     inertia = load33(bodies.inertia_local, i)
     inv_inertia = load33(bodies.inv_inertia_local, i)

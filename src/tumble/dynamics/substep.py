@@ -65,14 +65,16 @@ def integrate_velocities(bodies, moving, gravity, force, torque, acts, tau, quat
         if not moving[i]:
             continue
         q = load4(quat, i)
-        driven_force, driven_torque = actuator_wrench(acts, i, tau, q, load3(linvel, i), load3(angvel, i))
-        applied = add(add(load3(force, i), load3(bodies.constant_force, i)), driven_force)
+        applied = add(load3(force, i), load3(bodies.constant_force, i))
+        spin = add(load3(torque, i), load3(bodies.constant_torque, i))
+        if acts.driven[i]:
+            driven_force, driven_torque = actuator_wrench(acts, i, tau, q, load3(linvel, i), load3(angvel, i))
+            applied, spin = add(applied, driven_force), add(spin, driven_torque)
         accel = add_scaled((gravity[0], gravity[1], gravity[2]), applied, bodies.inv_mass[i])
         v = scale(add_scaled(load3(linvel, i), accel, h), 1.0 / (1.0 + h * bodies.linear_damping[i]))
         store3(linvel, i, v)
         w_body = quat_rotate_inv(q, load3(angvel, i))
         inertia = load33(bodies.inertia_local, i)
-        spin = add(add(load3(torque, i), load3(bodies.constant_torque, i)), driven_torque)
         w_body = implicit_spin(q, w_body, inertia, spin, bodies.angular_damping[i], h)
         store3(angvel, i, quat_rotate(q, w_body))
 
