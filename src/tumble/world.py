@@ -334,7 +334,8 @@ class World:
 
     def add_drag(self, body: Body, coefficients) -> None:
         """Parasitic drag on ``body``: the force ``−c ⊙ |v_air| v_air`` at its COM, in its frame, with ``c =
-        coefficients`` (cx, cy, cz) [kg/m] and ``v_air`` its velocity relative to the wind. Again replaces."""
+        coefficients`` (cx, cy, cz) [kg/m] and ``v_air`` its velocity relative to the wind. Called again for a body,
+        it replaces the coefficients."""
         self._actuation.add_drag(self, body, coefficients)
 
     def add_sensor(self, sensor: Sensor) -> Sensor:
@@ -522,16 +523,26 @@ class World:
             SimulationError: the step produced a non-finite value; the world keeps its state from before.
         """
         dt = as_float("dt", dt, positive=True)
+        failing = self._controlled_step(dt)
+        if failing >= 0:
+            raise self._simulation_error(failing)
+
+    def _controlled_step(self, dt: float) -> int:
+        """The controllers that are due, one step, the sensors' samples: the failing body's row, or -1.
+
+        Raises:
+            SimulationError: a controller raised (before the step: the world is as it was).
+        """
         self._controllers.run(self, dt)
         self._sync()
         for sensor in self._sensors:
             sensor._before_step()
-        steps_done, failing = simulate_steps(self._model, self._state, self._inputs, self._params, self._scratch, dt,
-                                             acts=self._actuators_for_step(dt))  # fmt: skip
-        if failing >= 0:
-            raise self._simulation_error(failing)
-        for sensor in self._sensors:
-            sensor._sample(dt)
+        _, failing = simulate_steps(self._model, self._state, self._inputs, self._params, self._scratch, dt,
+                                    acts=self._actuators_for_step(dt))  # fmt: skip
+        if failing < 0:
+            for sensor in self._sensors:
+                sensor._sample(dt)
+        return failing
 
     def _actuators_for_step(self, dt: float):
         """The actuators' arrays and the wind for the next steps; their bodies are kept awake (thrust that holds a
@@ -595,20 +606,13 @@ class World:
         failing_body, error)``."""
         for step in range(n_steps):
             try:
-                self._controllers.run(self, dt)
+                failing = self._controlled_step(dt)
             except SimulationError as error:
                 return step, -1, error
-            self._sync()
             if self._state.body_count != recording.pos.shape[1]:
                 raise ValueError("a controller added bodies during simulate; add them before it, or between calls")
-            for sensor in self._sensors:
-                sensor._before_step()
-            _, failing = simulate_steps(self._model, self._state, self._inputs, self._params, self._scratch, dt,
-                                        acts=self._actuators_for_step(dt))  # fmt: skip
             if failing >= 0:
                 return step, failing, None
-            for sensor in self._sensors:
-                sensor._sample(dt)
             if (step + 1) % record_every == 0:
                 frame = (step + 1) // record_every - 1
                 for name in ("pos", "quat", "linvel", "angmom"):
