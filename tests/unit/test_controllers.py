@@ -149,3 +149,20 @@ def test_the_handle_names_itself():
 
     assert repr(world.add_controller(hover, rate=100)) == "<Controller 'hover' at 100 Hz, 0 calls>"
     assert world.add_controller(hover, name="other").name == "other"
+
+
+@pytest.mark.parametrize("plane", [False, True], ids=["free", "contacts"])
+def test_a_controller_that_does_nothing_changes_nothing(plane):
+    """Step by step from Python (with a controller) or in one compiled call: the same recording, bit for bit."""
+
+    def recorded(with_controller):
+        world, ball = falling_ball(plane)
+        ball.angular_velocity = (1.0, 2.0, 3.0)
+        if with_controller:
+            world.add_controller(lambda w, t: None, rate=7)
+        return world.simulate(1.5, 0.01, record_every=3)
+
+    a, b = recorded(True), recorded(False)
+    np.testing.assert_array_equal(a.time, b.time)
+    np.testing.assert_array_equal(a.position, b.position)
+    np.testing.assert_array_equal(a.orientation, b.orientation)
