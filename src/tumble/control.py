@@ -17,7 +17,7 @@ from collections.abc import Callable
 
 from .errors import SimulationError
 
-__all__ = ["Controller", "Controllers"]
+__all__ = ["Controller", "Controllers", "StepClock"]
 
 # A tick at most this fraction of a step after the step's start time counts as reached (round-off in k / rate).
 _TICK_TOLERANCE = 1e-9
@@ -59,12 +59,28 @@ class Controller:
         return f"<Controller {self.name!r} at {rate}, {self.calls} calls>"
 
 
+class StepClock:
+    """A world's counted time: the start of the next step is ``t0 + n dt``, ``n`` the steps taken at this ``dt``
+    since ``t0``, when ``dt`` last changed (or the world's time was set apart from the count, as by a restore)."""
+
+    def __init__(self):
+        self._origin = (0.0, 0, math.nan)  # (time, step count, dt) when the count started
+
+    def start_of_next_step(self, world_time: float, step_count: int, dt: float) -> float:
+        origin_time, origin_step, origin_dt = self._origin
+        counted = origin_time + (step_count - origin_step) * dt
+        # The world's accumulated time agrees with the count to round-off, unless it was set from elsewhere.
+        if dt != origin_dt or step_count < origin_step or abs(counted - world_time) > 0.5 * dt:
+            self._origin = world_time, step_count, dt
+            return world_time
+        return counted
+
+
 class Controllers:
-    """A world's controllers, in the order added, and its counted clock."""
+    """A world's controllers, in the order added."""
 
     def __init__(self):
         self._items: list[Controller] = []
-        self._origin = (0.0, 0, math.nan)  # (time, step count, dt) when dt last changed
 
     def __len__(self) -> int:
         return len(self._items)
@@ -92,21 +108,13 @@ class Controllers:
             raise ValueError(f"controller {controller.name!r} is not in this world (removed already?)")
         self._items.remove(controller)
 
-    def time(self, world_time: float, step_count: int, dt: float) -> float:
-        """The start time of the next step of ``dt``: counted from when ``dt`` last changed."""
-        origin_time, origin_step, origin_dt = self._origin
-        if dt != origin_dt or step_count < origin_step:
-            self._origin = origin_time, origin_step, origin_dt = world_time, step_count, dt
-        return origin_time + (step_count - origin_step) * dt
-
-    def run(self, world, dt: float) -> None:
-        """Run the controllers due before the next step of ``dt``.
+    def run(self, world, t: float, dt: float) -> None:
+        """Run the controllers due before the next step, of ``dt`` from ``t`` (the :class:`StepClock`'s).
 
         Raises:
             SimulationError: a controller raised; the message names it and the time, the world is as it was.
         """
         state = world.state
-        t = self.time(state.time, state.step_count, dt)
         for controller in self:
             if not controller._due(t, dt):
                 continue

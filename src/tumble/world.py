@@ -16,7 +16,7 @@ from . import diagnostics
 from ._validate import as_float, as_quaternion, as_vector3, mass_or_density
 from .actuators import Actuation, Actuator
 from .builder import ModelBuilder, ShapeSpec
-from .control import Controller, Controllers
+from .control import Controller, Controllers, StepClock
 from .errors import SimulationError
 from .handles import Body, Joint
 from .inputs import Inputs
@@ -203,6 +203,7 @@ class World:
         self._bodies: list[Body] = []
         self._joints: list[Joint] = []
         self._controllers = Controllers()
+        self._clock = StepClock()
         self._actuation = Actuation()
         self._sensors: list[Sensor] = []
         self._wind: Wind | None = None
@@ -533,7 +534,7 @@ class World:
         Raises:
             SimulationError: a controller raised (before the step: the world is as it was).
         """
-        self._controllers.run(self, dt)
+        self._controllers.run(self, self._next_step_time(dt), dt)
         self._sync()
         for sensor in self._sensors:
             sensor._before_step()
@@ -544,12 +545,15 @@ class World:
                 sensor._sample(dt)
         return failing
 
+    def _next_step_time(self, dt: float) -> float:
+        """The next step's start time as controllers and wind see it: counted, not accumulated."""
+        return self._clock.start_of_next_step(self._state.time, self._state.step_count, dt)
+
     def _actuators_for_step(self, dt: float):
         """The actuators' arrays and the wind for the next steps; their bodies are kept awake (thrust that holds a
         body still must not let it sleep, or a change of wind or command would not reach it)."""
         if self._wind is not None:
-            t = self._controllers.time(self._state.time, self._state.step_count, dt)
-            self._actuation.wind = self._wind.velocity(t, dt)
+            self._actuation.wind = self._wind.velocity(self._next_step_time(dt), dt)
         else:
             self._actuation.wind = np.zeros(3)
         acts = self._actuation.for_bodies(self._model.body_com_local)

@@ -21,13 +21,14 @@ def box_world(gravity=(0, 0, -G), ground=False, **body):
     return world, world.add_body(tumble.Box((0.4, 0.3, 0.2)), mass=2.0, **body)
 
 
+@pytest.mark.parametrize("rate", [60, 240, 1000])
 @pytest.mark.parametrize("angle", [0.0, math.pi / 2])
-def test_an_imu_at_rest_on_the_ground_reads_plus_g_up_and_no_spin(angle):
+def test_an_imu_at_rest_on_the_ground_reads_plus_g_up_and_no_spin(angle, rate):
     turn = quat_from_axis_angle((1, 0, 0), angle)
     height = 0.1 if angle == 0.0 else 0.15
     world, body = box_world(ground=True, position=(0, 0, height), orientation=turn)
     imu = world.add_sensor(IMU(body, position=(0.1, -0.05, 0.1)))
-    world.simulate(2.0, 1 / 60)
+    world.simulate(2.0, 1 / rate)
     specific_force, angular_velocity = imu.read()
     np.testing.assert_allclose(specific_force, quat_to_matrix(turn).T @ (0, 0, G), atol=1e-6)
     np.testing.assert_allclose(angular_velocity, 0.0, atol=1e-9)

@@ -166,3 +166,14 @@ def test_a_controller_that_does_nothing_changes_nothing(plane):
     np.testing.assert_array_equal(a.time, b.time)
     np.testing.assert_array_equal(a.position, b.position)
     np.testing.assert_array_equal(a.orientation, b.orientation)
+
+
+def test_the_clock_counts_steps_and_starts_again_where_time_is_set_apart():
+    from tumble.control import StepClock
+
+    clock = StepClock()
+    assert clock.start_of_next_step(0.0, 0, 0.01) == 0.0
+    assert clock.start_of_next_step(0.9999999999999999, 100, 0.01) == 1.0  # counted, not the accumulated sum
+    assert clock.start_of_next_step(5.0, 100, 0.01) == 5.0  # a state restored from elsewhere
+    assert clock.start_of_next_step(5.02, 102, 0.01) == 5.0 + 2 * 0.01
+    assert clock.start_of_next_step(5.04, 103, 0.02) == 5.04  # a new dt counts from here
