@@ -12,6 +12,9 @@ at rest on the ground it reads ``(0, 0, +g)`` and zero, in free fall zero. White
 per step from zero (``accel_bias_walk`` [m/s²/√s], ``gyro_bias_walk`` [rad/s/√s]; Woodman, "An introduction to
 inertial navigation", Cambridge TR-696, 2007).
 
+The noiseless values of all the sensors of a world are computed together from the state arrays
+(:class:`Sensors`, one NumPy pass per step); each sensor then adds its own noise.
+
 Pose (motion capture): the body's position plus white noise of ``position_noise`` [m] per axis, and its orientation
 turned by a random rotation whose rotation vector has ``orientation_noise`` [rad] per axis.
 """
@@ -20,40 +23,37 @@ from __future__ import annotations
 
 import numpy as np
 
+from . import diagnostics
 from ._validate import as_body, as_dynamic_body_of, as_float, as_seed, as_vector3
 from .rotation import quat_from_rotvec, quat_multiply, quat_to_matrix
 
-__all__ = ["IMU", "Pose", "Sensor"]
+__all__ = ["IMU", "Pose", "Sensor", "Sensors"]
 
 
 class Sensor:
-    """What every sensor shares: its body, its generator, its link to a world."""
+    """What every sensor shares: its body, its generator, its link to a world, its last reading."""
 
     def __init__(self, body, seed):
         self.body = as_body(body)
         self.seed = as_seed(seed)
         self._rng = np.random.default_rng(seed)
         self._world = None
+        self._reading: tuple[np.ndarray, np.ndarray] | None = None  # None: no step yet
 
-    def _attach(self, world) -> None:
-        if self._world is not None:
-            raise ValueError(f"{self!r} is in a world already")
-        as_dynamic_body_of(world, self.body, "a sensor")
-        self._world = world
-        self._reset()
+    def read(self) -> tuple[np.ndarray, np.ndarray]:
+        """The last step's sample (before any step: the state as it is, without noise)."""
+        if self._reading is None:
+            self._world._sensors.refresh(self._world)
+            return self._reading_now()
+        return self._reading[0].copy(), self._reading[1].copy()
 
-    def _reset(self) -> None:
-        """The reading before any step."""
-
-    def _before_step(self) -> None:
-        """Note what the sample after the step needs."""
-
-    def _sample(self, dt: float) -> None:
-        """Take the sample of the step just taken."""
+    def _reading_now(self) -> tuple[np.ndarray, np.ndarray]:
+        raise NotImplementedError
 
 
 class IMU(Sensor):
-    """An accelerometer and a gyroscope on ``body`` at ``position`` (body frame); see the module docstring."""
+    """An accelerometer and a gyroscope on ``body`` at ``position`` (body frame); see the module docstring.
+    ``read()`` gives ``(specific_force_body [m/s²], angular_velocity_body [rad/s])``."""
 
     def __init__(self, body, position=(0.0, 0.0, 0.0), accel_noise=0.0, gyro_noise=0.0, accel_bias_walk=0.0,
                  gyro_bias_walk=0.0, seed=None):  # fmt: skip
@@ -65,69 +65,111 @@ class IMU(Sensor):
         self.gyro_bias_walk = as_float("gyro_bias_walk", gyro_bias_walk, nonnegative=True)
         self.accel_bias = np.zeros(3)
         self.gyro_bias = np.zeros(3)
-        self._reading = (np.zeros(3), np.zeros(3))
-        self._point_velocity = np.zeros(3)
-        self._orientation = np.array([1.0, 0.0, 0.0, 0.0])
 
-    def _arm(self) -> np.ndarray:
-        """From the COM to the sensor, world frame."""
-        return quat_to_matrix(self.body.orientation) @ (self.position - self.body._com_local())
+    def _reading_now(self):
+        # Before any step: a body not accelerating, whose specific force is −g.
+        bank = self._world._sensors
+        row = bank.imus.index(self)
+        rotation = quat_to_matrix(bank.imu_quat[row])
+        return rotation.T @ -self._world.gravity, rotation.T @ bank.imu_omega[row]
 
-    def _point(self) -> np.ndarray:
-        return self.body.velocity + np.cross(self.body.angular_velocity, self._arm())
-
-    def _reset(self) -> None:
-        # Before any step: the reading of a body not accelerating (specific force −g), no noise.
-        rotation = quat_to_matrix(self.body.orientation)
-        self._reading = (rotation.T @ -self._world.gravity, rotation.T @ self.body.angular_velocity)
-
-    def _before_step(self) -> None:
-        self._point_velocity = self._point()
-        self._orientation = self.body.orientation
-
-    def _sample(self, dt: float) -> None:
-        rotation = quat_to_matrix(self.body.orientation)
-        # The mean acceleration over the step, in the body frame of the step's middle (second order in ω dt).
-        acceleration = (self._point() - self._point_velocity) / dt
-        q0, q1 = self._orientation, self.body.orientation
-        middle = quat_to_matrix(q0 + q1 if np.dot(q0, q1) >= 0.0 else q0 - q1)
+    def _take(self, specific_force: np.ndarray, angular_velocity: np.ndarray, dt: float) -> None:
+        """Add this step's bias walk and noise to the true values."""
         self.accel_bias = self.accel_bias + self.accel_bias_walk * np.sqrt(dt) * self._rng.standard_normal(3)
         self.gyro_bias = self.gyro_bias + self.gyro_bias_walk * np.sqrt(dt) * self._rng.standard_normal(3)
-        specific_force = middle.T @ (acceleration - self._world.gravity)
-        angular_velocity = rotation.T @ self.body.angular_velocity
         self._reading = (
             specific_force + self.accel_bias + self.accel_noise * self._rng.standard_normal(3),
             angular_velocity + self.gyro_bias + self.gyro_noise * self._rng.standard_normal(3),
         )
-
-    def read(self) -> tuple[np.ndarray, np.ndarray]:
-        """``(specific_force_body [m/s²], angular_velocity_body [rad/s])`` of the last step."""
-        return self._reading[0].copy(), self._reading[1].copy()
 
     def __repr__(self) -> str:
         return f"<IMU on body {self.body.name or self.body.index!r}>"
 
 
 class Pose(Sensor):
-    """Motion capture of ``body``: position and orientation with noise; see the module docstring."""
+    """Motion capture of ``body``: ``read()`` gives ``(position [m], orientation [w, x, y, z])`` with noise; see the
+    module docstring."""
 
     def __init__(self, body, position_noise=0.0, orientation_noise=0.0, seed=None):
         super().__init__(body, seed)
         self.position_noise = as_float("position_noise", position_noise, nonnegative=True)
         self.orientation_noise = as_float("orientation_noise", orientation_noise, nonnegative=True)
-        self._reading = (np.zeros(3), np.array([1.0, 0.0, 0.0, 0.0]))
 
-    def _reset(self) -> None:
-        self._reading = (self.body.position.copy(), self.body.orientation.copy())
+    def _reading_now(self):
+        return self.body.position, self.body.orientation
 
-    def _sample(self, dt: float) -> None:
-        position = self.body.position + self.position_noise * self._rng.standard_normal(3)
+    def _take(self, position: np.ndarray, orientation: np.ndarray, dt: float) -> None:
+        noisy = position + self.position_noise * self._rng.standard_normal(3)
         turn = quat_from_rotvec(self.orientation_noise * self._rng.standard_normal(3))
-        self._reading = (position, quat_multiply(turn, self.body.orientation))
-
-    def read(self) -> tuple[np.ndarray, np.ndarray]:
-        """``(position [m], orientation quaternion [w, x, y, z])`` of the last step."""
-        return self._reading[0].copy(), self._reading[1].copy()
+        self._reading = (noisy, quat_multiply(turn, orientation))
 
     def __repr__(self) -> str:
         return f"<Pose sensor on body {self.body.name or self.body.index!r}>"
+
+
+class Sensors:
+    """A world's sensors: their true values from the state arrays, all IMUs (and all poses) in one NumPy pass."""
+
+    def __init__(self):
+        self.imus: list[IMU] = []
+        self.poses: list[Pose] = []
+        self.imu_quat = self.imu_omega = self._point_velocity = np.zeros((0, 3))
+        self._imu_bodies = self._imu_positions = self._pose_bodies = None  # gathered on first use after an add
+
+    def __len__(self) -> int:
+        return len(self.imus) + len(self.poses)
+
+    def __iter__(self):
+        return iter([*self.imus, *self.poses])
+
+    def add(self, world, sensor) -> Sensor:
+        if not isinstance(sensor, Sensor):
+            raise TypeError(f"sensor must be a tumble.sensors.IMU or Pose, got {sensor!r}")
+        if sensor._world is not None:
+            raise ValueError(f"{sensor!r} is in a world already")
+        as_dynamic_body_of(world, sensor.body, "a sensor")
+        sensor._world = world
+        (self.imus if isinstance(sensor, IMU) else self.poses).append(sensor)
+        self._imu_bodies = self._imu_positions = self._pose_bodies = None
+        return sensor
+
+    def refresh(self, world) -> None:
+        """Each IMU's orientation, angular velocity and point velocity now (world frame)."""
+        model, state = world.model, world.state
+        if self._imu_bodies is None:
+            self._imu_bodies = np.array([imu.body.index for imu in self.imus], np.int64)
+            self._imu_positions = np.array([imu.position for imu in self.imus]).reshape(-1, 3)
+        bodies = self._imu_bodies
+        self.imu_quat = state.body_quat[bodies]
+        self.imu_omega = diagnostics.world_tensor_apply(model.body_inv_inertia_local[bodies], self.imu_quat,
+                                                        state.body_angmom[bodies])  # fmt: skip
+        arms = self._imu_positions - model.body_com_local[bodies]
+        arms = np.einsum("nij,nj->ni", quat_to_matrix(self.imu_quat), arms)
+        self._point_velocity = state.body_linvel[bodies] + np.cross(self.imu_omega, arms)
+
+    def before_step(self, world) -> None:
+        if self.imus:
+            self.refresh(world)
+
+    def sample(self, world, dt: float) -> None:
+        """The samples of the step just taken."""
+        if self.imus:
+            quat0, velocity0 = self.imu_quat, self._point_velocity
+            self.refresh(world)
+            # The mean acceleration over the step, in the body frame of the step's middle (second order in ω dt).
+            acceleration = (self._point_velocity - velocity0) / dt - world.gravity
+            aligned = np.where(np.einsum("ni,ni->n", quat0, self.imu_quat)[:, None] >= 0.0, self.imu_quat,
+                               -self.imu_quat)  # fmt: skip
+            specific_force = np.einsum("nji,nj->ni", quat_to_matrix(quat0 + aligned), acceleration)
+            angular_velocity = np.einsum("nji,nj->ni", quat_to_matrix(self.imu_quat), self.imu_omega)
+            for row, imu in enumerate(self.imus):
+                imu._take(specific_force[row], angular_velocity[row], dt)
+        if self.poses:
+            state, com = world.state, world.model.body_com_local
+            if self._pose_bodies is None:
+                self._pose_bodies = np.array([pose.body.index for pose in self.poses], np.int64)
+            bodies = self._pose_bodies
+            quat = state.body_quat[bodies]
+            origins = state.body_pos[bodies] - np.einsum("nij,nj->ni", quat_to_matrix(quat), com[bodies])
+            for row, pose in enumerate(self.poses):
+                pose._take(origins[row], quat[row], dt)

@@ -27,7 +27,7 @@ from .pipeline import simulate_steps
 from .queries import Contacts, RayHit
 from .rotation import quat_rotate
 from .scratch import Scratch
-from .sensors import Sensor
+from .sensors import Sensor, Sensors
 from .shapes import Plane, Shape, TriMesh
 from .state import State
 from .trajectory import Trajectory
@@ -205,7 +205,7 @@ class World:
         self._controllers = Controllers()
         self._clock = StepClock()
         self._actuation = Actuation()
-        self._sensors: list[Sensor] = []
+        self._sensors = Sensors()
         self._wind: Wind | None = None
 
     # --- building -----------------------------------------------------------------------------------
@@ -342,15 +342,11 @@ class World:
     def add_sensor(self, sensor: Sensor) -> Sensor:
         """Add a :class:`~tumble.sensors.IMU` or :class:`~tumble.sensors.Pose`; returns it, to ``read()``. It samples
         at the end of every step."""
-        if not isinstance(sensor, Sensor):
-            raise TypeError(f"sensor must be a tumble.sensors.IMU or Pose, got {sensor!r}")
-        sensor._attach(self)
-        self._sensors.append(sensor)
-        return sensor
+        return self._sensors.add(self, sensor)
 
     @property
     def sensors(self) -> list[Sensor]:
-        """The sensors, in the order added."""
+        """The sensors: the IMUs, then the pose sensors, each in the order added."""
         return list(self._sensors)
 
     @property
@@ -536,13 +532,11 @@ class World:
         """
         self._controllers.run(self, self._next_step_time(dt), dt)
         self._sync()
-        for sensor in self._sensors:
-            sensor._before_step()
+        self._sensors.before_step(self)
         _, failing = simulate_steps(self._model, self._state, self._inputs, self._params, self._scratch, dt,
                                     acts=self._actuators_for_step(dt))  # fmt: skip
         if failing < 0:
-            for sensor in self._sensors:
-                sensor._sample(dt)
+            self._sensors.sample(self, dt)
         return failing
 
     def _next_step_time(self, dt: float) -> float:
