@@ -25,9 +25,11 @@ import json
 import math
 import os
 import shutil
+import signal
 import sys
 import tempfile
 import time
+import weakref
 from pathlib import Path
 
 __all__ = ["main", "EXIT_OK", "EXIT_SIMULATION", "EXIT_BAD_INPUT", "EXIT_INTERRUPTED"]
@@ -245,6 +247,36 @@ class _Progress:
             self._bar.update(self._task, completed=steps, t=world.time)
 
 
+class _InterruptLatch:
+    """Ctrl-C that cannot be lost. Python raises ``KeyboardInterrupt`` wherever the main thread is, and drops it,
+    with a traceback on stderr, when that is a weakref callback or a ``__del__`` ("Exception ignored in ..."): the
+    run then went on. The latch raises it at once unless it landed in one of those, and remembers it, so that the
+    next chunk's callback raises it in any case."""
+
+    def __init__(self) -> None:
+        self.requested = False
+        self._previous = None
+
+    def __enter__(self):
+        if hasattr(signal, "SIGINT"):
+            self._previous = signal.signal(signal.SIGINT, self._handle)
+        return self
+
+    def __exit__(self, *exc) -> None:
+        if self._previous is not None:
+            signal.signal(signal.SIGINT, self._previous)
+
+    def _handle(self, signum, frame) -> None:
+        self.requested = True
+        if frame is not None and (frame.f_code.co_name == "__del__" or frame.f_code.co_filename == weakref.__file__):
+            return  # Python would drop it here: the next chunk raises it
+        raise KeyboardInterrupt
+
+    def check(self) -> None:
+        if self.requested:
+            raise KeyboardInterrupt
+
+
 def _chunk_frames(body_count: int, frames: int, hdf5: bool) -> int:
     from .recording import default_chunk_frames
 
@@ -292,10 +324,16 @@ def _cmd_run(args) -> int:
         failure = None
         need_frames = html_path is not None or plot_path is not None
         began = time.perf_counter()
+        latch = _InterruptLatch()
+
+        def each_chunk(world, writer) -> None:
+            progress(world, writer)
+            latch.check()
+
         try:
-            with progress, np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+            with latch, progress, np.errstate(over="ignore", invalid="ignore", divide="ignore"):
                 trajectory = recording.record(world, duration, dt, path, every=every, chunk_frames=chunk,
-                                              scene=_scene_metadata(scene_path, loaded), callback=progress,
+                                              scene=_scene_metadata(scene_path, loaded), callback=each_chunk,
                                               load=need_frames)  # fmt: skip
         except SimulationError as error:
             failure = error
