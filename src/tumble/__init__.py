@@ -12,7 +12,7 @@ from __future__ import annotations
 
 __version__ = "0.1.0"
 
-from . import actuators, control, mass, rotation, sensors, shapes, wind
+from . import actuators, control, mass, rotation, sensors, shapes, vehicles, wind
 from .errors import SimulationError
 from .handles import Body, Joint
 from .joints import BallJoint, DistanceJoint, FixedJoint, HingeJoint, SliderJoint
@@ -75,5 +75,6 @@ __all__ = [
     "rotation",
     "sensors",
     "shapes",
+    "vehicles",
     "wind",
 ]

@@ -17,7 +17,22 @@ from collections.abc import Callable
 
 from .errors import SimulationError
 
-__all__ = ["Controller", "Controllers", "StepClock"]
+# The flight controllers and reference trajectories have their own modules; they belong to this namespace.
+from .flight import Autopilot, CascadedPID, SE3Controller
+from .references import Circle, Hover, Lissajous, MinimumSnap
+
+__all__ = [
+    "Autopilot",
+    "CascadedPID",
+    "Circle",
+    "Controller",
+    "Controllers",
+    "Hover",
+    "Lissajous",
+    "MinimumSnap",
+    "SE3Controller",
+    "StepClock",
+]
 
 # A tick at most this fraction of a step after the step's start time counts as reached (round-off in k / rate).
 _TICK_TOLERANCE = 1e-9

@@ -44,8 +44,10 @@ _SYMMETRY_RTOL = 1e-9
 # An eigenvalue of a PSD tensor computed in float64 can come out as -eps * trace; a rod (particles on a
 # line) has one exactly-zero principal moment, so the bound is -1e-12 trace (about 1e4 eps).
 _PSD_RTOL = 1e-12
-# A lamina has I1 + I2 = I3 exactly; eigvalsh then leaves ~1e-15 trace of rounding on either side.
-_TRIANGLE_RTOL = 1e-9
+# A lamina has I1 + I2 = I3 exactly, and measured tensors miss it by their measurement error: the Crazyflie's
+# diag(1.43, 1.43, 2.89) e-5 kg m² (J. Förster, ETH Zürich 2015, the figures RotorPy flies) by 0.5 % of the trace.
+# A tensor is refused when I1 + I2 falls short of I3 by more than 1 % of the trace.
+_TRIANGLE_RTOL = 1e-2
 
 
 def _show(value) -> str:
