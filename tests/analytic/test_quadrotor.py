@@ -3,6 +3,9 @@ RotorPy's Crazyflie (1.25 cm RMS on the circle, 4.7 cm on the figure eight, 7.5 
 
 from __future__ import annotations
 
+import re
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -25,9 +28,9 @@ def hovering(params=CRAZYFLIE, position=(0.0, 0.0, 1.0), ground=False, **world_k
     return world, quad
 
 
-def fly(trajectory, controller=SE3Controller, duration=12.0, dt=1e-2, rate=100.0, wind=None, **gains):
-    """Fly ``trajectory`` from its start; the recording and the position error over time."""
-    world, quad = hovering(position=trajectory(0.0)["position"])
+def fly(trajectory, controller=SE3Controller, duration=12.0, dt=1e-2, rate=100.0, wind=None, start=None, **gains):
+    """Fly ``trajectory`` from its start (or ``start``); the recording and the position error over time."""
+    world, quad = hovering(position=trajectory(0.0)["position"] if start is None else start)
     world.wind = wind
     quad.fly(controller(quad, **gains), trajectory, rate=rate)
     recording = world.simulate(duration, dt)
@@ -121,6 +124,16 @@ def test_the_figure_eight_is_tracked_within_six_centimetres(controller):
     assert rms <= 0.06  # RotorPy: 4.7 cm; here 5.0 cm
 
 
+def test_the_motor_lag_bounds_the_attitude_gains():
+    """The attitude loop with a lagging motor, τ s³ + s² + k_Ω s + k_R, is stable only while k_Ω > τ k_R: the
+    Crazyflie's own gains (310, 57; 57 > 22) hold it, the Hummingbird's (544, 46.64; 46.6 > 39.2 but with the
+    100 Hz hold's delay too little margin) let its 72 ms motors rock it off the sky."""
+    _, own = fly(Hover((0.1, 0.0, 1.0)), duration=5.0, start=(0.0, 0.0, 1.0))
+    assert own[-1] < 1e-3
+    _, borrowed = fly(Hover((0.1, 0.0, 1.0)), duration=5.0, start=(0.0, 0.0, 1.0), kp_att=544.0, kd_att=46.64)
+    assert borrowed.max() > 0.5
+
+
 def test_the_rate_feedforward_is_available_and_flies():
     recording, error = fly(Lissajous(1.0, 0.5, 1.0, 2.0, center=(0.0, 0.0, 1.0)), feedforward=True)
     assert np.sqrt(np.mean(error[recording.time >= 2.0] ** 2)) <= 0.04  # 3.4 cm
@@ -189,3 +202,14 @@ class TestAutopilotLevels:
         np.testing.assert_allclose(quad.body.velocity, (1.0, 0.5, 0.2), rtol=0.08)  # P loop against rotor drag
         quad.command_rotor_speeds([0.0] * 4)
         assert not quad.autopilot.active and world.controllers == []
+
+
+def test_the_worked_flight_of_docs_quadrotor_md_takes_off_follows_the_path_and_lands():
+    text = (Path(__file__).resolve().parents[2] / "docs" / "quadrotor.md").read_text()
+    namespace: dict = {}
+    exec(re.search(r"```python\n(.*?)```", text, re.S).group(1), namespace)
+    error, quad, world = namespace["error"], namespace["quad"], namespace["world"]
+    assert np.sqrt(np.mean(error**2)) < 0.02 and error.max() < 0.025
+    np.testing.assert_allclose(quad.body.position, (2.0, 0.0, 0.4 * CRAZYFLIE["arm_length"]), atol=1e-2)
+    assert abs(quad.body.position[2] - 0.4 * CRAZYFLIE["arm_length"]) < 5e-4  # on its feet
+    assert np.linalg.norm(quad.body.velocity) < 1e-3 and len(world.contacts().body_a) >= 4
