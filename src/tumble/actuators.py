@@ -23,7 +23,7 @@ import numpy as np
 from ._validate import as_body, as_dynamic_body_of, as_float, as_unit_vector3, as_vector3
 from .dynamics.actuation import ROTOR, THRUSTER, ActuatorArrays
 
-__all__ = ["Actuator", "Rotor", "Thruster"]
+__all__ = ["Actuator", "Rotor", "Thruster", "command_all"]
 
 
 class Actuator:
@@ -152,6 +152,23 @@ class Thruster(Actuator):
 
     def __repr__(self) -> str:
         return f"<Thruster on body {self.body.name or self.body.index!r}: {self.commanded_force:.6g} N>"
+
+
+def command_all(rotors, speeds: np.ndarray) -> None:
+    """``rotor.command(speed)`` for each pair, in one write when the rotors share their world's arrays (a vehicle
+    commanded at every step of a fast world)."""
+    owner = rotors[0]._owner
+    if owner is None or any(rotor._owner is not owner for rotor in rotors):
+        for rotor, speed in zip(rotors, speeds, strict=True):
+            rotor.command(float(speed))
+        return
+    low = [rotor.speed_min for rotor in rotors]
+    high = [rotor.speed_max for rotor in rotors]
+    owner.arrays.command[[rotor._row for rotor in rotors]] = np.minimum(np.maximum(speeds, low), high)
+    rotors[0].body._require_dynamic("command an actuator")
+    for rotor in rotors[1:]:
+        if rotor.body is not rotors[0].body:
+            rotor.body._require_dynamic("command an actuator")
 
 
 class Actuation:

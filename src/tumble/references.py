@@ -20,8 +20,13 @@ __all__ = ["Circle", "Hover", "Lissajous", "MinimumSnap"]
 _DERIVATIVES = ("position", "velocity", "acceleration", "jerk", "snap")
 
 
+_ORDERS = np.arange(5)
+
+
 def _flat_output(derivatives, yaw: float = 0.0, yaw_rate: float = 0.0) -> dict:
-    out = {name: np.asarray(value, dtype=float) for name, value in zip(_DERIVATIVES, derivatives, strict=True)}
+    """The reference as a dict: the rows of ``derivatives`` (5, 3), position to snap, and the yaw and its rate."""
+    rows = np.asarray(derivatives, dtype=float)
+    out = dict(zip(_DERIVATIVES, rows, strict=True))
     out.update(yaw=float(yaw), yaw_rate=float(yaw_rate))
     return out
 
@@ -87,10 +92,10 @@ class Lissajous:
     def __call__(self, t) -> dict:
         t = _time(t)
         # The k-th derivative of A sin(a t + δ) is A a^k sin(a t + δ + k π/2).
-        x = [self.A * self.a**k * math.sin(self.a * t + self.delta + k * math.pi / 2) for k in range(5)]
-        y = [self.B * self.b**k * math.sin(self.b * t + k * math.pi / 2) for k in range(5)]
-        derivatives = [(xk, yk, 0.0) for xk, yk in zip(x, y, strict=True)]
-        derivatives[0] = self.center + derivatives[0]
+        derivatives = np.zeros((5, 3))
+        derivatives[:, 0] = self.A * self.a**_ORDERS * np.sin(self.a * t + self.delta + _ORDERS * (math.pi / 2))
+        derivatives[:, 1] = self.B * self.b**_ORDERS * np.sin(self.b * t + _ORDERS * (math.pi / 2))
+        derivatives[0] += self.center
         return _flat_output(derivatives, self.yaw)
 
     def __repr__(self) -> str:

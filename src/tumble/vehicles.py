@@ -22,7 +22,8 @@ from types import MappingProxyType
 import numpy as np
 
 from ._validate import as_array, as_float, as_vector3
-from .actuators import Rotor
+from .actuators import Rotor, command_all
+from .flight.kernels import allocate_speeds
 from .mass import MassProperties
 from .shapes import Box, Sphere
 
@@ -107,7 +108,8 @@ class Mixer:
         self.inverse = np.linalg.inv(self.matrix)
         for array in (self.matrix, self.inverse):
             array.flags.writeable = False
-        self._squared_limits = (speed_min**2, speed_max**2)
+        self.k_thrust = k_thrust
+        self.squared_limits = (speed_min**2, speed_max**2)  # the bounds of each ω²
 
     def wrench(self, rotor_speeds) -> np.ndarray:
         """``(T, Mx, My, Mz)`` of the rotors at ``rotor_speeds`` (4,) [rad/s]."""
@@ -121,26 +123,10 @@ class Mixer:
         priority: the thrust first (clipped to what four rotors between their limits can give), then roll and pitch
         together (scaled down, keeping the direction of the tilting moment), then yaw; what is kept is met
         exactly."""
-        thrust = as_float("thrust", thrust)
-        moments = as_vector3("moments", moments)
-        low, high = self._squared_limits
-        per_rotor = np.clip(thrust / self.matrix[0].sum(), low, high)  # the thrust row's entries are all k_thrust
-        squared = np.full(4, per_rotor)
-        for wrench in ((0.0, moments[0], moments[1], 0.0), (0.0, 0.0, 0.0, moments[2])):
-            change = self.inverse @ np.asarray(wrench)
-            squared = squared + _largest_fraction_within(squared, change, low, high) * change
-        return np.sqrt(np.clip(squared, low, high))
-
-
-def _largest_fraction_within(start: np.ndarray, change: np.ndarray, low: float, high: float) -> float:
-    """The largest ``s`` in [0, 1] with ``low <= start + s change <= high`` (``start`` within the bounds)."""
-    fraction = 1.0
-    for x, dx in zip(start, change, strict=True):
-        if dx > 0.0 and x + dx > high:
-            fraction = min(fraction, (high - x) / dx)
-        elif dx < 0.0 and x + dx < low:
-            fraction = min(fraction, (low - x) / dx)
-    return max(fraction, 0.0)
+        speeds = np.empty(4)
+        allocate_speeds(self.inverse, self.k_thrust, *self.squared_limits, as_float("thrust", thrust),
+                        as_vector3("moments", moments), speeds)  # fmt: skip
+        return speeds
 
 
 class Quadrotor:
@@ -220,8 +206,7 @@ class Quadrotor:
         self._command(speeds)
 
     def _command(self, speeds: np.ndarray) -> None:
-        for rotor, speed in zip(self.rotors, speeds, strict=True):
-            rotor.command(float(speed))
+        command_all(self.rotors, speeds)
 
     def _stop_autopilot(self) -> None:
         if self._autopilot is not None:

@@ -10,37 +10,26 @@ mixer (``Mixer.allocate``, which keeps the thrust first under saturation).
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
-from ._validate import as_array, as_float, as_quaternion, as_vector3
-from .rotation import quat_to_matrix
+from .._validate import as_array, as_float, as_quaternion, as_vector3
+from ..rotation import quat_to_matrix
+from . import kernels
 
 __all__ = ["Autopilot", "CascadedPID", "SE3Controller", "fly"]
 
 
-def _vee(skew_matrix: np.ndarray) -> np.ndarray:
-    """The inverse of the hat operator: ``vee(skew(a)) = a``."""
-    return np.array([skew_matrix[2, 1], skew_matrix[0, 2], skew_matrix[1, 0]])
-
-
-def desired_rotation(force: np.ndarray, yaw: float) -> np.ndarray:
+def desired_rotation(force, yaw: float) -> np.ndarray:
     """The rotation whose ``z`` axis is along ``force`` and whose ``x`` axis is the heading ``yaw`` projected on the
-    plane normal to it (Lee et al. 2010, section IV): ``b3 = f/|f|``, ``b2 = b3 × b1c / |…|``, ``b1 = b2 × b3``."""
-    norm = np.linalg.norm(force)
-    b3 = force / norm if norm > 0.0 else np.array([0.0, 0.0, 1.0])
-    heading = np.array([math.cos(yaw), math.sin(yaw), 0.0])
-    b2 = np.cross(b3, heading)
-    b2_norm = np.linalg.norm(b2)
-    b2 = b2 / b2_norm if b2_norm > 1e-9 else np.array([-math.sin(yaw), math.cos(yaw), 0.0])  # thrust horizontal
-    return np.column_stack([np.cross(b2, b3), b2, b3])
+    plane normal to it (Lee et al. 2010, section IV; :func:`tumble.flight.kernels.desired_axes`)."""
+    return np.column_stack(kernels.desired_axes((float(force[0]), float(force[1]), float(force[2])), float(yaw)))
 
 
 def attitude_error(rotation: np.ndarray, desired: np.ndarray) -> np.ndarray:
     """``e_R = ½ vee(R_dᵀ R − Rᵀ R_d)`` (Lee et al. 2010, eq. 10): for a small error, the rotation vector from the
     desired attitude to the present one, body frame."""
-    return 0.5 * _vee(desired.T @ rotation - rotation.T @ desired)
+    axes = tuple(tuple(float(x) for x in desired[:, k]) for k in range(3))
+    return np.array(kernels.attitude_error(tuple(float(x) for x in rotation.ravel()), *axes))
 
 
 def _gains(name: str, value, size: int) -> np.ndarray:
@@ -55,7 +44,7 @@ def _gains(name: str, value, size: int) -> np.ndarray:
 
 
 def _vehicle(quad):
-    from .vehicles import Quadrotor
+    from ..vehicles import Quadrotor
 
     if not isinstance(quad, Quadrotor):
         raise TypeError(f"quad must be a tumble.vehicles.Quadrotor, got {quad!r}")
@@ -75,12 +64,15 @@ class _Integral:
 
     def __init__(self, gain: np.ndarray, limit: float):
         self.gain, self.limit = gain, limit
+        self._active = bool(gain.any())
         self.value = np.zeros(3)
         self._last_time: float | None = None
 
     def update(self, t: float, error: np.ndarray) -> np.ndarray:
         """``k_i ∫e`` including the interval that ends now, at ``t``."""
-        if self._last_time is not None and t > self._last_time and self.gain.any():
+        if not self._active:
+            return self.value
+        if self._last_time is not None and t > self._last_time:
             self.value += error * (t - self._last_time)
             bound = np.divide(self.limit, self.gain, out=np.full(3, np.inf), where=self.gain > 0.0)
             np.clip(self.value, -bound, bound, out=self.value)
@@ -92,17 +84,27 @@ class _Integral:
         self._last_time = None
 
 
-def _reference_of(reference) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, float, float]:
-    try:
-        return (as_vector3("reference['position']", reference["position"]),
-                as_vector3("reference['velocity']", reference.get("velocity", (0.0, 0.0, 0.0))),
-                as_vector3("reference['acceleration']", reference.get("acceleration", (0.0, 0.0, 0.0))),
-                as_vector3("reference['jerk']", reference.get("jerk", (0.0, 0.0, 0.0))),
-                as_float("reference['yaw']", reference.get("yaw", 0.0)),
-                as_float("reference['yaw_rate']", reference.get("yaw_rate", 0.0)))  # fmt: skip
-    except (KeyError, AttributeError) as error:
+_REFERENCE_VECTORS = ("position", "velocity", "acceleration", "jerk")
+
+
+def _reference_of(reference) -> tuple[np.ndarray, float, float]:
+    """``(packed, yaw, yaw_rate)``: ``packed`` (4, 3) the reference's position, velocity, acceleration and jerk (those
+    missing are zero; ``position`` is needed)."""
+    if not hasattr(reference, "get") or "position" not in reference:
         raise TypeError(f"reference must be a mapping with at least 'position' (what a trajectory returns), got "
-                        f"{reference!r}") from error  # fmt: skip
+                        f"{reference!r}")  # fmt: skip
+    packed = np.zeros((4, 3))
+    for row, name in enumerate(_REFERENCE_VECTORS):
+        value = reference.get(name)
+        if value is not None:
+            try:
+                packed[row] = value
+            except (TypeError, ValueError) as error:
+                raise ValueError(f"reference[{name!r}] must be 3 numbers, got {value!r}") from error
+    if not np.isfinite(packed).all():
+        raise ValueError(f"reference must be finite, got {dict(reference)!r}")
+    return packed, as_float("reference['yaw']", reference.get("yaw", 0.0)), \
+        as_float("reference['yaw_rate']", reference.get("yaw_rate", 0.0))  # fmt: skip
 
 
 class SE3Controller:
@@ -145,6 +147,7 @@ class SE3Controller:
         self.kp_att, self.kd_att = _attitude_gains(self.quad, kp_att, kd_att)
         self.feedforward = bool(feedforward)
         self._integral = _Integral(self.ki_pos, as_float("integral_limit", integral_limit, nonnegative=True))
+        self._inv_inertia = np.linalg.inv(self.quad.params["inertia"])
 
     def reset(self) -> None:
         """Forget the integral of the position error."""
@@ -153,24 +156,17 @@ class SE3Controller:
     def update(self, t: float, reference) -> np.ndarray:
         """Rotor speeds (4,) [rad/s] that steer the vehicle towards ``reference`` (a trajectory's ``traj(t)``)."""
         t = as_float("t", t)
-        position, velocity, acceleration, jerk, yaw, yaw_rate = _reference_of(reference)
-        quad, body = self.quad, self.quad.body
-        mass, inertia = quad.params["mass"], quad.params["inertia"]
-        error = body.position - position
-        force = mass * (-self.kp_pos * error - self.kd_pos * (body.velocity - velocity)
-                        - self._integral.update(t, error) + acceleration - quad.world.gravity)  # fmt: skip
-        rotation = body.rotation
-        thrust = float(force @ rotation[:, 2])
-        desired = desired_rotation(force, yaw)
-        if self.feedforward:
-            h = mass * (jerk - (desired[:, 2] @ jerk) * desired[:, 2]) / max(np.linalg.norm(force), 1e-12)
-            rates_desired = np.array([-h @ desired[:, 1], h @ desired[:, 0], yaw_rate * desired[2, 2]])
-        else:
-            rates_desired = np.array([0.0, 0.0, yaw_rate])
-        rates = body.angular_velocity_body
-        rate_error = rates - rotation.T @ desired @ rates_desired
-        moments = inertia @ (-self.kp_att * attitude_error(rotation, desired) - self.kd_att * rate_error)
-        return quad.mixer.allocate(thrust, moments + np.cross(rates, inertia @ rates))
+        packed, yaw, yaw_rate = _reference_of(reference)
+        quad, params, mixer = self.quad, self.quad.params, self.quad.mixer
+        state, i = quad.world.state, quad.body.index
+        integral = self._integral.update(t, state.body_pos[i] - packed[0])
+        speeds = np.empty(4)
+        kernels.se3_rotor_speeds(state.body_pos[i], state.body_linvel[i], state.body_quat[i], state.body_angmom[i],
+                                 self._inv_inertia, params["inertia"], params["mass"], quad.world.gravity, packed, yaw,
+                                 yaw_rate, self.kp_pos, self.kd_pos, integral, self.kp_att, self.kd_att,
+                                 self.feedforward, mixer.inverse, params["k_thrust"], *mixer.squared_limits,
+                                 speeds)  # fmt: skip
+        return speeds
 
 
 class Autopilot:
@@ -289,7 +285,7 @@ class CascadedPID:
     def update(self, t: float, reference) -> np.ndarray:
         """Rotor speeds (4,) [rad/s] that steer the vehicle towards ``reference``."""
         t = as_float("t", t)
-        position, velocity, acceleration, _, yaw, yaw_rate = _reference_of(reference)
+        (position, velocity, acceleration, _), yaw, yaw_rate = _reference_of(reference)
         body = self.quad.body
         velocity_error = velocity + self.kp_pos * (position - body.position) - body.velocity
         acceleration = acceleration + self._loops.kp_vel * velocity_error + self._integral.update(t, velocity_error)
