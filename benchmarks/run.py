@@ -17,6 +17,8 @@ Run from the repository root:
                  beside MuJoCo's Euler and RK4, 10 s at dt = 1 ms (``benchmarks/articulation.py``).
 ``world_chain``  a 20-link chain of world hinge joints released horizontal, 10 s: steps/s, joint gaps and energy,
                  tumble against PyBullet and MuJoCo (``benchmarks/joints.py``).
+``quadrotor``    a Crazyflie flying the figure eight at 100 and 500 Hz with the SE(3) controller every step,
+                 tumble against RotorPy (``benchmarks/quadrotor.py``).
 
 Every timing is the best of ``--repeat`` runs after a first call that is reported apart (it includes the
 JIT compile or the load from Numba's disk cache). Both engines run in the same process, so compare the
@@ -46,7 +48,7 @@ import numpy as np
 
 import tumble
 
-from . import articulation, contact, joints, peers
+from . import articulation, contact, joints, peers, quadrotor
 
 __all__ = [
     "BENCHMARKS",
@@ -95,6 +97,8 @@ class Sizes:
     big_pyramid_seconds: float = 2.0
     chain_links: int = 20  # world-joint chain (benchmarks/joints.py)
     chain_seconds: float = 10.0
+    quadrotor_seconds: float = 10.0  # simulated time of each quadrotor flight (benchmarks/quadrotor.py)
+    rotorpy_seconds: float = 10.0  # at most this much for RotorPy's own flights
 
 
 FULL = Sizes()
@@ -102,7 +106,7 @@ QUICK = Sizes(
     tumbling_steps=200, record_every=100, bodies=64, body_steps=50, mujoco_seconds=0.02, repeat=1,
     cold_start=False, cold_start_bodies=8, pile_boxes=27, pile_seconds=0.2, pyramid_base=4, pyramid_seconds=0.2,
     cubes_boxes=(8, 27), cubes_seconds=0.2, big_pyramid_base=6, big_pyramid_seconds=0.2, chain_links=4,
-    chain_seconds=0.2,
+    chain_seconds=0.2, quadrotor_seconds=0.2, rotorpy_seconds=0.2,
 )  # fmt: skip
 
 
@@ -568,6 +572,10 @@ def check_targets(results: dict[str, list[dict]]) -> list[dict]:
         limit = 1.5 if row["cache"] == "warm" else 20.0
         add(f"{row['cache']} start: import + first step (s)", row["import_plus_step_s"], f"< {limit:g}",
             row["import_plus_step_s"] < limit)  # fmt: skip
+    for row in results.get("quadrotor", []):
+        if row["engine"] == "tumble" and row["controller"].startswith("SE3") and math.isfinite(row["x_rotorpy"]):
+            add(f"quadrotor {row['rate_hz']} Hz, SE3 every step: steps/s vs RotorPy (x)", row["x_rotorpy"], ">= 100",
+                row["x_rotorpy"] >= 100)  # fmt: skip
     return targets
 
 
@@ -653,6 +661,7 @@ BENCHMARKS: dict[str, Callable[[Sizes], list[dict]]] = {
     "articulation_chain": lambda sizes: articulation.bench_chain(
         articulation.FULL if sizes.repeat > 1 else articulation.QUICK
     ),
+    "quadrotor": quadrotor.bench_quadrotor,
 }
 OPTIONAL = ("big_pyramid",)  # slow: run only when asked for with --only
 

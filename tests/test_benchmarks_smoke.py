@@ -15,7 +15,7 @@ REPO = Path(__file__).resolve().parent.parent
 if str(REPO) not in sys.path:
     sys.path.insert(0, str(REPO))
 
-from benchmarks import joints, peers, run  # noqa: E402
+from benchmarks import joints, peers, quadrotor, run  # noqa: E402
 
 TINY = run.Sizes(
     tumbling_steps=40, record_every=10, bodies=8, body_steps=5, mujoco_seconds=0.002, repeat=1,
@@ -212,3 +212,11 @@ def test_world_chain_is_the_pendulum_chain_scene_without_collisions():
     assert [b.name for b in chain.bodies] == [f"link{k}" for k in range(5)]
     assert len(chain.joints) == 5 and all(j.kind == "hinge" for j in chain.joints)
     assert not chain.model.shape_mask.any()  # the benchmark's links collide with nothing
+
+
+def test_quadrotor_rows_for_every_controller_and_rate():
+    sizes = run.Sizes(**{**run.QUICK.__dict__, "quadrotor_seconds": 0.05, "rotorpy_seconds": 0.05})
+    rows = quadrotor.bench_quadrotor(sizes)
+    _assert_finite_numbers([{k: v for k, v in r.items() if k not in ("rms_error_cm", "x_rotorpy")} for r in rows])
+    tumble_rows = {(r["controller"], r["rate_hz"]) for r in rows if r["engine"] == "tumble"}
+    assert len(tumble_rows) == 3 * len(quadrotor.RATES)
