@@ -28,6 +28,9 @@ PINNED = {
     r"r cos θ \+ √\(l² − r² sin² θ\)",
     "joints/ragdoll.py": r"final: pelvis from 2\.61 m to 0\.[0-4]\d m in 3\.0 s, no body centre under a tread, "
     r"joint gaps \d\.\d mm now",
+    # The quadrotor through three gates (issue 19, first version: 5.5 cm RMS, 10.3 cm at most).
+    "vehicles/gates.py": r"final: 3 of 3 gates passed in 8\.3 s, [4-6]\.\d cm RMS off the path, "
+    r"(9|1[01])\.\d cm at most",
 }
 STEPS = {
     "basic/hello_world.py": 100,
@@ -38,6 +41,7 @@ STEPS = {
     "joints/door.py": 150,
     "joints/slider_crank.py": 120,
     "joints/ragdoll.py": 180,
+    "vehicles/gates.py": 4150,
 }
 
 
@@ -66,3 +70,10 @@ def test_demo_writes_its_plot(tmp_path, monkeypatch):
     monkeypatch.setattr(module, "OUT", tmp_path)
     module.main(steps=3000, render=True)
     assert (tmp_path / "dzhanibekov.png").stat().st_size > 10_000
+
+
+def test_gates_example_writes_its_replay_and_plots(tmp_path, monkeypatch):
+    module = load("vehicles/gates.py")
+    monkeypatch.setattr(module, "OUT", tmp_path)
+    assert module.main(steps=1500, render=True).startswith("final: 1 of 3 gates passed in 3.0 s")
+    assert (tmp_path / "gates.png").stat().st_size > 20_000 and (tmp_path / "gates.html").stat().st_size > 50_000

@@ -177,6 +177,8 @@ class Quadrotor:
             world.add_drag(self.body, p["drag_coefficients"])
         self.mixer = Mixer(hubs, p["rotor_directions"], p["k_thrust"], p["k_moment"], p["speed_min"], p["speed_max"])
         self._autopilot = None
+        self._flight = None  # what fly() attached (tumble.flight.Flight)
+        world._vehicles.append(self)
 
     @property
     def rotor_speeds(self) -> np.ndarray:

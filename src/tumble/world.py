@@ -207,6 +207,7 @@ class World:
         self._actuation = Actuation()
         self._sensors = Sensors()
         self._wind: Wind | None = None
+        self._vehicles: list = []  # tumble.vehicles.Quadrotor, each one body with its actuators
 
     # --- building -----------------------------------------------------------------------------------
 

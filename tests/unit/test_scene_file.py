@@ -181,10 +181,18 @@ BASE = tomllib.loads(
 PATHS = [p for p in _paths(BASE) if p]
 
 
-@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
-@given(st.lists(st.tuples(st.sampled_from(PATHS), JUNK), min_size=1, max_size=3))
-def test_random_mutations_give_clean_errors_or_valid_worlds(mutations):
-    data = copy.deepcopy(BASE)
+VEHICLES = tomllib.loads(
+    '[[vehicles]]\ntype = "quadrotor"\nname = "cf"\nposition = [0, 0, 1]\nrotor_speeds = "hover"\n'
+    'controller = { type = "se3", rate = 100.0, kp_pos = [6.5, 6.5, 15.0] }\n'
+    'trajectory = { type = "minimum_snap", waypoints = [[0, 0, 1], [1, 0, 1]], times = [0.0, 2.0] }\n'
+    '[[vehicles]]\ntype = "quadrotor"\nparams = { base = "hummingbird", mass = 0.6 }\ncommands = [1, 2, 3, 4]\n'
+    '[wind]\ntype = "dryden"\nmean = [2.0, 0.0, 0.0]\nsigma = 0.5\nlength_scale = 10.0\nseed = 1\n'
+)
+VEHICLE_PATHS = [p for p in _paths(VEHICLES) if p]
+
+
+def _mutant_builds_or_fails_cleanly(base: dict, mutations) -> None:
+    data = copy.deepcopy(base)
     for path, junk in mutations:
         node = data
         try:
@@ -199,6 +207,18 @@ def test_random_mutations_give_clean_errors_or_valid_worlds(mutations):
         assert str(error).startswith("mutant:")
         return
     assert all(math.isfinite(m) for m in world.model.body_mass)
+
+
+@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(st.lists(st.tuples(st.sampled_from(PATHS), JUNK), min_size=1, max_size=3))
+def test_random_mutations_give_clean_errors_or_valid_worlds(mutations):
+    _mutant_builds_or_fails_cleanly(BASE, mutations)
+
+
+@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(st.lists(st.tuples(st.sampled_from(VEHICLE_PATHS), JUNK), min_size=1, max_size=3))
+def test_random_mutations_of_vehicles_and_wind_give_clean_errors_or_valid_worlds(mutations):
+    _mutant_builds_or_fails_cleanly(VEHICLES, mutations)
 
 
 def test_an_articulation_in_a_scene_becomes_bodies_and_joints(tmp_path):

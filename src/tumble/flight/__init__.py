@@ -10,6 +10,8 @@ mixer (``Mixer.allocate``, which keeps the thrust first under saturation).
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 
 from .._validate import as_array, as_float, as_quaternion, as_vector3
@@ -146,7 +148,8 @@ class SE3Controller:
         )
         self.kp_att, self.kd_att = _attitude_gains(self.quad, kp_att, kd_att)
         self.feedforward = bool(feedforward)
-        self._integral = _Integral(self.ki_pos, as_float("integral_limit", integral_limit, nonnegative=True))
+        self.integral_limit = as_float("integral_limit", integral_limit, nonnegative=True)
+        self._integral = _Integral(self.ki_pos, self.integral_limit)
         self._inv_inertia = np.linalg.inv(self.quad.params["inertia"])
 
     def reset(self) -> None:
@@ -276,7 +279,13 @@ class CascadedPID:
         self.kp_pos = _gains("kp_pos", kp_pos, 3)
         self.ki_vel = _gains("ki_vel", ki_vel, 3)
         self._loops = Autopilot(quad, kp_rate, kp_att, kp_vel)
-        self._integral = _Integral(self.ki_vel, as_float("integral_limit", integral_limit, nonnegative=True))
+        self.integral_limit = as_float("integral_limit", integral_limit, nonnegative=True)
+        self._integral = _Integral(self.ki_vel, self.integral_limit)
+
+    # The inner loops' gains are the autopilot's.
+    kp_vel = property(lambda self: self._loops.kp_vel, doc="velocity gain [1/s] (3,)")
+    kp_att = property(lambda self: self._loops.kp_att, doc="attitude gain [1/s]")
+    kp_rate = property(lambda self: self._loops.kp_rate, doc="body-rate gain [1/s]")
 
     def reset(self) -> None:
         """Forget the integral of the velocity error."""
@@ -290,6 +299,15 @@ class CascadedPID:
         velocity_error = velocity + self.kp_pos * (position - body.position) - body.velocity
         acceleration = acceleration + self._loops.kp_vel * velocity_error + self._integral.update(t, velocity_error)
         return self._loops._acceleration_to_speeds(acceleration, yaw, yaw_rate)
+
+
+class Flight(NamedTuple):
+    """What :func:`fly` attached to a vehicle: the controller, the trajectory, the rate and the world controller."""
+
+    controller: object
+    trajectory: object
+    rate: float | None
+    handle: object
 
 
 def fly(quad, controller, trajectory, rate: float | None = None):
@@ -308,4 +326,6 @@ def fly(quad, controller, trajectory, rate: float | None = None):
                              f"not four finite rotor speeds")  # fmt: skip
         quad.command_rotor_speeds(speeds)
 
-    return quad.world.add_controller(follow, rate=rate, name=name)
+    handle = quad.world.add_controller(follow, rate=rate, name=name)
+    quad._flight = Flight(controller, trajectory, rate, handle)
+    return handle

@@ -54,7 +54,7 @@ def _place(location: tuple) -> str:
     for part in location:
         if isinstance(part, int):
             text += f"[{part}]"
-        elif part in _UNION_TAGS or part.startswith(("tuple[", "function-")):
+        elif part in _UNION_TAGS or part == "QuadrotorParams" or part.startswith(("tuple[", "function-", "literal[")):
             continue
         else:
             text += f".{part}" if text else part
@@ -62,7 +62,8 @@ def _place(location: tuple) -> str:
 
 
 _UNION_TAGS = {"sphere", "box", "capsule", "cylinder", "plane", "hull", "mesh", "ball", "hinge", "slider", "fixed",
-               "distance", "spring", "rope"}  # fmt: skip
+               "distance", "spring", "rope", "se3", "cascaded_pid", "hover", "circle", "lissajous", "minimum_snap",
+               "constant", "sinusoid", "dryden"}  # fmt: skip
 
 
 def _validation_message(label: str, error: ValidationError) -> str:

@@ -14,6 +14,7 @@ from .. import joints as joint_types
 from ..shapes import Box, Capsule, ConvexHull, Cylinder, Plane, Sphere, TriMesh
 from ..world import World
 from . import schema
+from .vehicles import build_vehicle, build_wind
 
 __all__ = ["SceneError", "build_world"]
 
@@ -134,6 +135,19 @@ def _articulation(spec: schema.Articulation, gravity, base: Path, place: str, la
     return art
 
 
+def _vehicles(world, specs, label: str) -> dict:
+    """Build the ``[[vehicles]]``; their bodies by name."""
+    named = {}
+    for k, spec in enumerate(specs):
+        try:
+            body = build_vehicle(world, spec).body
+        except (ValueError, TypeError) as error:
+            raise SceneError(f"{label}: vehicles[{k}]: {error}") from error
+        if spec.name is not None:
+            named[spec.name] = body
+    return named
+
+
 def build_world(scene: schema.Scene, base: Path, label: str) -> World:
     """The world a validated scene describes; ``base`` is the directory mesh paths are relative to."""
     settings = scene.world
@@ -141,7 +155,10 @@ def build_world(scene: schema.Scene, base: Path, label: str) -> World:
                                           "joint_damping_ratio", "sleep"}, exclude_none=True)  # fmt: skip
     world = World(settings.gravity, integrator=settings.integrator, **solver)
     named: dict = {}
-    for kind, items in (("bodies", scene.bodies), ("static", scene.static)):
+    for kind, items in (("bodies", scene.bodies), ("vehicles", scene.vehicles), ("static", scene.static)):
+        if kind == "vehicles":  # after the bodies, before the static geometry: the order to_scene writes them in
+            named.update(_vehicles(world, items, label))
+            continue
         for k, item in enumerate(items):
             place = f"{kind}[{k}]"
             try:
@@ -181,6 +198,10 @@ def build_world(scene: schema.Scene, base: Path, label: str) -> World:
         except (ValueError, TypeError) as error:
             raise SceneError(f"{label}: {place}: {error}") from error
         named.update({body.name: body for body in copy.bodies})
+    try:
+        world.wind = build_wind(scene.wind)
+    except (ValueError, TypeError) as error:
+        raise SceneError(f"{label}: wind: {error}") from error
     for k, spec in enumerate(scene.joints):
         place = f"joints[{k}]"
         try:

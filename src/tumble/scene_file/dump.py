@@ -14,6 +14,7 @@ import numpy as np
 
 from ..rotation import quat_multiply, quat_rotate
 from ..shapes import Box, Capsule, ConvexHull, Cylinder, Plane, Sphere, TriMesh
+from .vehicles import vehicle_to_scene, wind_to_scene
 
 __all__ = ["world_to_scene"]
 
@@ -147,9 +148,17 @@ def world_to_scene(world, *, dt: float | None = None, duration: float | None = N
         settings["dt"] = float(dt)
     if duration is not None:
         settings["duration"] = float(duration)
-    return {
+    vehicles = {quad.body.index: quad for quad in world._vehicles}
+    scene = {
         "world": settings,
-        "bodies": [_body(world, b, names[b.index]) for b in world.bodies if not b.is_static],
+        "bodies": [
+            _body(world, b, names[b.index]) for b in world.bodies if not b.is_static and b.index not in vehicles
+        ],  # fmt: skip
         "static": [_placed(world, b, names[b.index]) for b in world.bodies if b.is_static],
         "joints": [_joint(j, names) for j in world.joints],
+        "vehicles": [vehicle_to_scene(quad, names[index]) for index, quad in vehicles.items()],
     }
+    wind = wind_to_scene(world.wind)
+    if wind is not None:
+        scene["wind"] = wind
+    return scene

@@ -261,6 +261,142 @@ class Articulation(_Strict):
     qd: list[Finite] | None = None
 
 
+# --- vehicles and wind (docs/quadrotor.md) ----------------------------------------------------------------
+
+Gain = Finite | Vector3  # one number for every axis, or one per axis
+
+
+class QuadrotorParams(_Strict):
+    """A parameter set: a shipped one (``base``) with any of its values replaced."""
+
+    base: Literal["crazyflie", "hummingbird"] = "crazyflie"
+    mass: Positive | None = None
+    inertia: Vector3 | tuple[Vector3, Vector3, Vector3] | None = None
+    arm_length: Positive | None = None
+    k_thrust: Positive | None = None
+    k_moment: NonNegative | None = None
+    k_drag: NonNegative | None = None
+    k_inflow: NonNegative | None = None
+    speed_min: NonNegative | None = None
+    speed_max: Positive | None = None
+    time_constant: NonNegative | None = None
+    rotor_directions: tuple[Literal[-1, 1], Literal[-1, 1], Literal[-1, 1], Literal[-1, 1]] | None = None
+    drag_coefficients: Vector3 | None = None
+    kp_att: NonNegative | None = None
+    kd_att: NonNegative | None = None
+
+
+class SE3ControllerSpec(_Strict):
+    type: Literal["se3"]
+    rate: Positive | None = None  # Hz; omitted: every step
+    kp_pos: Gain | None = None
+    kd_pos: Gain | None = None
+    ki_pos: Gain | None = None
+    kp_att: Finite | None = None
+    kd_att: Finite | None = None
+    integral_limit: Finite | None = None
+    feedforward: bool = False
+
+
+class CascadedPIDSpec(_Strict):
+    type: Literal["cascaded_pid"]
+    rate: Positive | None = None
+    kp_pos: Gain | None = None
+    kp_vel: Gain | None = None
+    ki_vel: Gain | None = None
+    kp_att: Finite | None = None
+    kp_rate: Finite | None = None
+    integral_limit: Finite | None = None
+
+
+FlightController = Annotated[SE3ControllerSpec | CascadedPIDSpec, Field(discriminator="type")]
+
+
+class HoverSpec(_Strict):
+    type: Literal["hover"]
+    position: Vector3
+    yaw: Finite = 0.0
+
+
+class CircleSpec(_Strict):
+    type: Literal["circle"]
+    center: Vector3
+    radius: Positive
+    frequency: NonNegative
+    yaw: Finite = 0.0
+
+
+class LissajousSpec(_Strict):
+    type: Literal["lissajous"]
+    A: NonNegative
+    B: NonNegative
+    a: Finite
+    b: Finite
+    delta: Finite = 0.0
+    center: Vector3 = (0.0, 0.0, 0.0)
+    yaw: Finite = 0.0
+
+
+class MinimumSnapSpec(_Strict):
+    type: Literal["minimum_snap"]
+    waypoints: list[Vector3] = Field(min_length=2)
+    times: list[Finite] | None = None
+    average_speed: Positive = 1.0
+    yaw: Finite = 0.0
+
+
+Reference = Annotated[HoverSpec | CircleSpec | LissajousSpec | MinimumSnapSpec, Field(discriminator="type")]
+
+
+class Vehicle(_Strict):
+    """A quadrotor (``tumble.vehicles.Quadrotor``): its body and four rotors, and what flies it: a ``controller``
+    following a ``trajectory`` (both or neither), or fixed rotor ``commands``."""
+
+    type: Literal["quadrotor"]
+    name: str | None = Field(default=None, min_length=1)
+    params: Literal["crazyflie", "hummingbird"] | QuadrotorParams = "crazyflie"
+    layout: Literal["x", "+"] = "x"
+    position: Vector3 = (0.0, 0.0, 0.0)
+    orientation: Quaternion = (1.0, 0.0, 0.0, 0.0)
+    velocity: Vector3 = (0.0, 0.0, 0.0)
+    angular_velocity: Vector3 = (0.0, 0.0, 0.0)
+    rotor_speeds: Literal["rest", "hover"] | tuple[NonNegative, NonNegative, NonNegative, NonNegative] = "rest"
+    commands: tuple[NonNegative, NonNegative, NonNegative, NonNegative] | None = None
+    controller: FlightController | None = None
+    trajectory: Reference | None = None
+
+    @model_validator(mode="after")
+    def _flown(self):
+        if (self.controller is None) != (self.trajectory is None):
+            raise ValueError("give a controller and a trajectory together, or neither")
+        if self.controller is not None and self.commands is not None:
+            raise ValueError("commands are for a vehicle without a controller")
+        return self
+
+
+class ConstantWind(_Strict):
+    type: Literal["constant"]
+    velocity: Vector3
+
+
+class SinusoidWind(_Strict):
+    type: Literal["sinusoid"]
+    mean: Vector3
+    amplitude: Vector3
+    frequency: NonNegative
+
+
+class DrydenWind(_Strict):
+    type: Literal["dryden"]
+    mean: Vector3
+    sigma: Gain
+    length_scale: Gain
+    seed: Annotated[int, Field(ge=0)] | None = None
+
+
+Wind = Annotated[ConstantWind | SinusoidWind | DrydenWind, Field(discriminator="type")]
+
+
 # --- the whole file ---------------------------------------------------------------------------------
 
 
@@ -284,7 +420,7 @@ class Recording(_Strict):
 
 class Scene(_Strict):
     """A scene file: ``[world]``, ``[materials.NAME]``, ``[[bodies]]``, ``[[static]]``, ``[[joints]]``,
-    ``[recording]``, and a free-text ``description``."""
+    ``[[articulations]]``, ``[[vehicles]]``, ``[wind]``, ``[recording]``, and a free-text ``description``."""
 
     description: str = ""
     world: WorldSettings = WorldSettings()
@@ -293,4 +429,6 @@ class Scene(_Strict):
     static: list[Static] = []
     joints: list[Joint] = []
     articulations: list[Articulation] = []
+    vehicles: list[Vehicle] = []
+    wind: Wind | None = None
     recording: Recording = Recording()
