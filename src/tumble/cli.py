@@ -40,7 +40,7 @@ EXIT_BAD_INPUT = 2
 EXIT_INTERRUPTED = 130
 
 TRAJECTORY_SUFFIXES = (".h5", ".hdf5", ".he5", ".npz")
-PLOT_KINDS = ("energy", "momentum", "omega", "paths")
+PLOT_KINDS = ("energy", "momentum", "omega", "paths", "flight")
 # The run is cut into about this many chunks (fewer for .npz, which is rewritten whole at each chunk), so that
 # the progress bar moves and Ctrl-C is answered within a chunk: the compiled loop only sees it between chunks.
 _TARGET_CHUNKS = {"h5": 50, "npz": 10}
@@ -393,6 +393,10 @@ def _write_outputs(trajectory, world, html_path, plot_path, title: str, max_fram
 
         plots.energy(trajectory, plot_path)
         _note(f"wrote {plot_path}")
+        if any(name.startswith("vehicle/") for name in trajectory.channels):
+            flight_path = plot_path.with_name(f"{plot_path.stem}_flight{plot_path.suffix}")
+            plots.flight(trajectory, path=flight_path)
+            _note(f"wrote {flight_path}")
 
 
 def _print_run_summary(console, world, scene_path: Path, *, dt, steps, planned, sim_time, wall, progress, energy_0,
@@ -610,6 +614,8 @@ def _cmd_plot(args) -> int:
                 plots.momentum(trajectory, target)
             elif kind == "omega":
                 plots.angular_velocity(trajectory, bodies=bodies, path=target)
+            elif kind == "flight":
+                plots.flight(trajectory, vehicle=bodies[0] if bodies else None, path=target)
             else:
                 plots.paths(trajectory, bodies=bodies, path=target)
         except (KeyError, IndexError, ValueError) as error:

@@ -1,4 +1,5 @@
-"""Plots of a :class:`~tumble.Trajectory`: energy, momentum, angular velocity and paths (matplotlib).
+"""Plots of a :class:`~tumble.Trajectory`: energy, momentum, angular velocity, paths, and the flight of its
+vehicles (matplotlib).
 
 Each function returns the matplotlib ``Figure`` and writes it to ``path`` when given (the format follows the
 suffix: ``.png``, ``.svg``, ``.pdf``). Figures are built with ``matplotlib.figure.Figure`` and its Agg canvas,
@@ -20,7 +21,7 @@ import os
 
 import numpy as np
 
-__all__ = ["energy", "momentum", "angular_velocity", "paths"]
+__all__ = ["energy", "momentum", "angular_velocity", "paths", "flight"]
 
 # Bodies drawn when ``bodies=None``: the first dynamic ones, at most this many (more would be unreadable).
 MAX_DEFAULT_BODIES = 8
@@ -225,5 +226,69 @@ def paths(trajectory, bodies=None, views=("xy", "xz"), path=None, axes=None):
             ax.grid(True, alpha=0.3)
         ax.set_title(f"Paths, {view} view" if view != "3d" else "Paths")
     given[0].legend(loc="best")
+    _finish(figure, path)
+    return figure
+
+
+def _euler_zyx(q: np.ndarray) -> np.ndarray:
+    """Roll, pitch, yaw (Z-Y-X Tait-Bryan angles: yaw about z, then pitch about y, then roll about x) of
+    quaternions (..., 4) [rad], as flight logs show attitude."""
+    w, x, y, z = np.moveaxis(q, -1, 0)
+    roll = np.arctan2(2 * (w * x + y * z), 1 - 2 * (x * x + y * y))
+    pitch = np.arcsin(np.clip(2 * (w * y - z * x), -1.0, 1.0))
+    yaw = np.arctan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
+    return np.stack([roll, pitch, yaw], axis=-1)
+
+
+def flight(trajectory, vehicle=None, path=None):
+    """The flight of one vehicle of a recording made with vehicles (``tumble run`` of a quadrotor scene, or
+    ``tumble.recording.record``): its position against its reference, the tracking error, its attitude (roll,
+    pitch, yaw) and its rotor speeds with their commands.
+
+    Args:
+        trajectory: a :class:`~tumble.Trajectory` with vehicle channels (``trajectory.channels``).
+        vehicle: the vehicle's (body's) name; default the first.
+        path: write the figure here if given.
+
+    Returns:
+        The ``Figure``: four axes, row by row.
+    """
+    _check_trajectory(trajectory)
+    names = {k[len("vehicle/") :].rsplit("/", 1)[0] for k in trajectory.channels if k.startswith("vehicle/")}
+    index = {name: int(name[1:]) if name.startswith("#") else trajectory.body_index(name) for name in names}
+    names = sorted(names, key=index.get)  # in the order of the bodies
+    if not names:
+        raise ValueError("this trajectory holds no vehicle channels: record a world with vehicles (tumble run of a "
+                         "quadrotor scene, or tumble.recording.record)")  # fmt: skip
+    name = names[0] if vehicle is None else str(vehicle)
+    if name not in names:
+        raise KeyError(f"no vehicle named {name!r} in this trajectory; vehicles: {names}")
+    i = index[name]
+    channel = {what: trajectory.channels[f"vehicle/{name}/{what}"] for what in ("rotor_speeds", "commands",
+                                                                                "reference")}  # fmt: skip
+    time, position = trajectory.time, trajectory.position[:, i]
+    figure, (ax_p, ax_e, ax_a, ax_r) = _new_figure(2, 2, size=(11.0, 7.5))
+    for k, c in enumerate(_COMPONENTS):
+        (line,) = ax_p.plot(time, position[:, k], label=c)
+        ax_p.plot(time, channel["reference"][:, k], "--", color=line.get_color(), lw=1)
+    ax_p.set_title(f"{name}: position (dashed: reference)")
+    ax_p.set_ylabel("[m]")
+    ax_e.plot(time, 100 * np.linalg.norm(position - channel["reference"], axis=1))
+    ax_e.set_title("Tracking error |x - x_ref|")
+    ax_e.set_ylabel("[cm]")
+    for k, label in enumerate(("roll", "pitch", "yaw")):
+        ax_a.plot(time, np.degrees(_euler_zyx(trajectory.orientation[:, i])[:, k]), label=label)
+    ax_a.set_title("Attitude (Z-Y-X angles)")
+    ax_a.set_ylabel("[deg]")
+    for k in range(4):
+        (line,) = ax_r.plot(time, channel["rotor_speeds"][:, k], label=f"rotor {k + 1}")
+        ax_r.plot(time, channel["commands"][:, k], ":", color=line.get_color(), lw=1)
+    ax_r.set_title("Rotor speeds (dotted: commands)")
+    ax_r.set_ylabel("[rad/s]")
+    for ax in (ax_p, ax_e, ax_a, ax_r):
+        ax.set_xlabel("time [s]")
+        ax.grid(True, alpha=0.3)
+    for ax in (ax_p, ax_a, ax_r):
+        ax.legend(loc="best", fontsize="small")
     _finish(figure, path)
     return figure

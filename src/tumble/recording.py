@@ -31,7 +31,7 @@ from .errors import SimulationError
 from .trajectory import Trajectory
 from .trajectory_io import FRAME_ARRAYS
 
-__all__ = ["TrajectoryWriter", "record", "default_chunk_frames"]
+__all__ = ["TrajectoryWriter", "VehicleLog", "record", "default_chunk_frames"]
 
 # A chunk of about 4 MiB of frames: large enough that writing it costs little next to the steps that made it,
 # small enough that a failed run loses little (1000 bodies: 40 frames).
@@ -130,6 +130,7 @@ class TrajectoryWriter:
         self._pending_count = 0
         self._written: list[dict] = []  # .npz only: every block written so far (the file is rewritten whole)
         self.frame_count = 0  # frames written to the file
+        self.channels: dict[str, np.ndarray] = {}  # per-frame arrays written with the last frames (close)
         self._hdf5 = trajectory_io.is_hdf5_path(self.path)
         self._h5 = None
         if self._hdf5:
@@ -202,6 +203,8 @@ class TrajectoryWriter:
         if self._hdf5:
             self._h5.set_metadata(self.metadata)
             self._h5.append(block if block is not None else {"time": np.zeros(0)})
+            if self.channels:
+                self._h5.write_channels(self.channels)
         else:
             if block is not None:
                 self._written.append(block)
@@ -213,7 +216,8 @@ class TrajectoryWriter:
             self._written = [frames]
         else:
             frames = {k: np.zeros((0, *self._frame_shape(k))) for k in FRAME_ARRAYS}
-        trajectory_io.write_npz(self.path, {**frames, **self._static}, self._names, self.metadata)
+        trajectory_io.write_npz(self.path, {**frames, **self._static}, self._names, self.metadata,
+                                channels=self.channels)  # fmt: skip
 
     def _frame_shape(self, name: str) -> tuple[int, ...]:
         return {"orientation": (self.body_count, 4), "time": (), "kinetic_energy": (), "potential_energy": ()}.get(
@@ -254,6 +258,48 @@ class TrajectoryWriter:
         return f"TrajectoryWriter({os.fspath(self.path)!r}, {self.frame_count} frames written, {state})"
 
 
+class VehicleLog:
+    """The channels of a world's vehicles, sampled with the frames of a recording (one every ``every`` steps from
+    now): for each vehicle ``vehicle/NAME/rotor_speeds`` and ``vehicle/NAME/commands`` (4,) [rad/s] and
+    ``vehicle/NAME/reference`` (3,) [m], the position its trajectory asks for (NaN when none is flown). It samples
+    from a world controller before each due step, and :meth:`sample` takes the state after the last one."""
+
+    def __init__(self, world, every: int):
+        self.every = every
+        self._start = world.step_count
+        self._vehicles = list(world._vehicles)
+        self._samples: list[list[np.ndarray]] = []
+        self._last_step: int | None = None
+        self._handle = world.add_controller(lambda world, t: self.sample(world), name="vehicle log")
+
+    def sample(self, world) -> None:
+        """Take the vehicles' values now if the step count is one of the frames' (once per step)."""
+        if (world.step_count - self._start) % self.every or world.step_count == self._last_step:
+            return
+        self._last_step = world.step_count
+        row = []
+        for quad in self._vehicles:
+            flight = quad._flight
+            flying = flight is not None and flight.handle in world.controllers
+            reference = flight.trajectory(world.time)["position"] if flying else np.full(3, np.nan)
+            row.append(np.concatenate([quad.rotor_speeds, quad.commanded_rotor_speeds, reference]))
+        self._samples.append(row)
+
+    def stop(self) -> None:
+        self._handle.remove()
+
+    def channels(self, frames: int) -> dict[str, np.ndarray]:
+        """The first ``frames`` samples of each channel."""
+        values = np.array(self._samples[:frames], dtype=float).reshape(-1, len(self._vehicles), 11)
+        out = {}
+        for k, quad in enumerate(self._vehicles):
+            name = quad.body.name or f"#{quad.body.index}"
+            for what, columns in (("rotor_speeds", slice(0, 4)), ("commands", slice(4, 8)),
+                                  ("reference", slice(8, 11))):  # fmt: skip
+                out[f"vehicle/{name}/{what}"] = values[:, k, columns]
+        return out
+
+
 def record(world, duration: float, dt: float, path, *, every: int = 1, chunk_frames: int | None = None, scene=None,
            callback=None, compression: str | None = None, load: bool = True) -> Trajectory | None:  # fmt: skip
     """Simulate ``round(duration / dt)`` steps, writing every ``every``-th frame to ``path`` as the run goes.
@@ -291,6 +337,17 @@ def record(world, duration: float, dt: float, path, *, every: int = 1, chunk_fra
         raise ValueError(f"duration={duration!r} is shorter than one step of dt={dt!r}")
     writer = TrajectoryWriter(path, world, every=every, chunk_frames=chunk_frames, scene=scene, dt=dt,
                               compression=compression)  # fmt: skip
+    log = VehicleLog(world, writer.every) if world._vehicles else None
+    try:
+        return _record_chunks(world, n_steps, dt, writer, log, callback, load)
+    finally:
+        if log is not None:
+            log.stop()
+
+
+def _record_chunks(world, n_steps: int, dt: float, writer: TrajectoryWriter, log: VehicleLog | None, callback,
+                   load: bool) -> Trajectory | None:  # fmt: skip
+    """:func:`record`'s loop: the chunks, each written before the next, and the vehicles' channels at the end."""
     with writer:
         writer.append(world)
         chunk_steps = writer.chunk_frames * writer.every
@@ -301,6 +358,8 @@ def record(world, duration: float, dt: float, path, *, every: int = 1, chunk_fra
                 chunk = world.simulate(steps * dt, dt, record_every=writer.every)
             except SimulationError as error:
                 writer.extend(error.trajectory[1:])
+                if log is not None:
+                    writer.channels = log.channels(writer.frame_count + writer._pending_count)
                 writer.close("failed", str(error))
                 error.trajectory = Trajectory.load(writer.path)
                 error.path = writer.path
@@ -311,4 +370,7 @@ def record(world, duration: float, dt: float, path, *, every: int = 1, chunk_fra
             done += steps
             if callback is not None:
                 callback(world, writer)
+        if log is not None:
+            log.sample(world)
+            writer.channels = log.channels(writer.frame_count)
     return Trajectory.load(writer.path) if load else None

@@ -64,6 +64,9 @@ class Trajectory:
         kinetic_energy, potential_energy: (T,) [J], summed over bodies.
         body_mass: (N,) [kg]; body_inertia: (N, 3, 3) about the COM, body frame; body_com_local: (N, 3).
         gravity: (3,) [m/s²]; body_names: N names (``""`` where unnamed); metadata: dt, integrator, version.
+        channels: other per-frame arrays by name, each (T, ...): a recording of a world with vehicles holds
+            ``vehicle/NAME/rotor_speeds``, ``vehicle/NAME/commands`` (4,) [rad/s] and ``vehicle/NAME/reference``
+            (3,) [m] (NaN while no trajectory is flown); see ``tumble.recording``.
     """
 
     time: np.ndarray
@@ -79,6 +82,7 @@ class Trajectory:
     gravity: np.ndarray
     body_names: list[str] = field(default_factory=list)
     metadata: dict = field(default_factory=dict)
+    channels: dict = field(default_factory=dict)
 
     # --- building (used by World.simulate) ----------------------------------------------------------
 
@@ -180,7 +184,8 @@ class Trajectory:
             raise TypeError(f"a trajectory is indexed by a slice of frames (traj[10:20]), got {frames!r}")
         picked = {k: getattr(self, k)[frames] for k in FRAME_ARRAYS}
         return Trajectory(**picked, **{k: getattr(self, k) for k in STATIC_ARRAYS},
-                          body_names=list(self.body_names), metadata=dict(self.metadata))  # fmt: skip
+                          body_names=list(self.body_names), metadata=dict(self.metadata),
+                          channels={k: v[frames] for k, v in self.channels.items()})  # fmt: skip
 
     def select_bodies(self, bodies=None, *, dynamic_only: bool = False) -> list[int]:
         """Body indices from ``bodies``: None (all bodies, or all dynamic ones with ``dynamic_only``), or a name,
@@ -216,12 +221,13 @@ class Trajectory:
         name without it, as numpy does). ``docs/files.md`` lists the arrays and the metadata."""
         arrays = {k: getattr(self, k) for k in FRAME_ARRAYS + STATIC_ARRAYS}
         if trajectory_io.is_hdf5_path(path):
-            trajectory_io.write_h5(path, arrays, self.body_names, self.metadata, compression=compression)
+            trajectory_io.write_h5(path, arrays, self.body_names, self.metadata, compression=compression,
+                                   channels=self.channels)  # fmt: skip
             return
         path = os.fspath(path)
         if not path.endswith(".npz"):
             path += ".npz"
-        trajectory_io.write_npz(path, arrays, self.body_names, self.metadata)
+        trajectory_io.write_npz(path, arrays, self.body_names, self.metadata, channels=self.channels)
 
     @classmethod
     def load(cls, path: str | os.PathLike) -> Trajectory:

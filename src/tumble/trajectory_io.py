@@ -72,7 +72,11 @@ def _h5py():
 # --- npz ----------------------------------------------------------------------------------------------------
 
 
-def write_npz(path: str | os.PathLike, arrays: dict, body_names: list[str], metadata: dict, *, compress=True) -> None:
+_CHANNEL = "channel:"  # the .npz key prefix of a channel; in HDF5 the group "channels"
+
+
+def write_npz(path: str | os.PathLike, arrays: dict, body_names: list[str], metadata: dict, *, compress=True,
+              channels: dict | None = None) -> None:  # fmt: skip
     """Write every array of :data:`FRAME_ARRAYS` and :data:`STATIC_ARRAYS` to ``path`` atomically.
 
     The file goes to ``path`` exactly (numpy's ``savez`` would add ``.npz`` to a name without it); it is written
@@ -87,6 +91,7 @@ def write_npz(path: str | os.PathLike, arrays: dict, body_names: list[str], meta
             **{k: arrays[k] for k in FRAME_ARRAYS + STATIC_ARRAYS},
             body_names=np.array(body_names, dtype=str).reshape(-1),
             metadata_json=np.array(metadata_to_json(metadata)),
+            **{f"{_CHANNEL}{name}": np.asarray(value, dtype=np.float64) for name, value in (channels or {}).items()},
         )
         f.flush()
         os.fsync(f.fileno())
@@ -99,6 +104,7 @@ def _read_npz(path) -> tuple[dict, list[str], dict]:
         if missing:
             raise ValueError(f"{os.fspath(path)!r} is not a tumble trajectory: missing arrays {missing}")
         arrays = {k: data[k] for k in FRAME_ARRAYS + STATIC_ARRAYS}
+        arrays["channels"] = {k[len(_CHANNEL) :]: data[k] for k in data.files if k.startswith(_CHANNEL)}
         names = [str(n) for n in data["body_names"]] if "body_names" in data else []
         if "metadata_json" in data:
             metadata = json.loads(str(data["metadata_json"]))
@@ -170,6 +176,15 @@ class H5Frames:
                 dataset[start:] = frames[name]
         self._file.flush()
 
+    def write_channels(self, channels: dict) -> None:
+        """Store the per-frame ``channels`` (name: (T, ...) array), replacing any stored before, and flush."""
+        group = self._file.require_group("channels")
+        for name, value in channels.items():
+            if name in group:
+                del group[name]
+            group.create_dataset(name, data=np.asarray(value, dtype=np.float64))
+        self._file.flush()
+
     def set_metadata(self, metadata: dict) -> None:
         """Store ``metadata`` unless it is what the file holds already: HDF5 does not reuse an attribute's old
         space, so rewriting an unchanged scene at every chunk made a flagship run's file 40 % larger."""
@@ -186,13 +201,15 @@ class H5Frames:
             self._file.close()
 
 
-def write_h5(path, arrays: dict, body_names: list[str], metadata: dict, *, compression: str | None = "gzip"
-             ) -> None:  # fmt: skip
+def write_h5(path, arrays: dict, body_names: list[str], metadata: dict, *, compression: str | None = "gzip",
+             channels: dict | None = None) -> None:  # fmt: skip
     """Write a whole trajectory to an HDF5 file at once."""
     static = {k: arrays[k] for k in STATIC_ARRAYS}
     out = H5Frames(path, static, body_names, metadata, chunk_frames=256, compression=compression)
     try:
         out.append({k: arrays[k] for k in FRAME_ARRAYS})
+        if channels:
+            out.write_channels(channels)
     finally:
         out.close()
 
@@ -204,6 +221,11 @@ def _read_h5(path) -> tuple[dict, list[str], dict]:
         if missing or f.attrs.get("format") != FORMAT_NAME:
             raise ValueError(f"{os.fspath(path)!r} is not a tumble trajectory: missing arrays {missing}")
         arrays = {k: f[k][()] for k in FRAME_ARRAYS + STATIC_ARRAYS}
+        channels = {}
+        if "channels" in f:
+            f["channels"].visititems(
+                lambda name, item: channels.update({name: item[()]}) if hasattr(item, "shape") else None
+            )
         names = [n.decode() if isinstance(n, bytes) else str(n) for n in f["body_names"][()]]
         metadata = json.loads(f.attrs.get("metadata", "{}"))
     # Frames are appended array by array: a file cut off between two of them has one array longer; keep the
@@ -211,6 +233,7 @@ def _read_h5(path) -> tuple[dict, list[str], dict]:
     count = min(arrays[k].shape[0] for k in FRAME_ARRAYS)
     for k in FRAME_ARRAYS:
         arrays[k] = arrays[k][:count]
+    arrays["channels"] = {name: value[:count] for name, value in channels.items()}
     return arrays, names, metadata
 
 

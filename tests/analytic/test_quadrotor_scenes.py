@@ -88,5 +88,9 @@ def test_every_quadrotor_scene_runs_from_the_command_line_with_plots_and_replay(
                "1.0", "--out", f"{out}.h5", "--plot", f"{out}.png", "--html", f"{out}.html"]  # fmt: skip
     result = subprocess.run(command, capture_output=True, text=True, timeout=280)
     assert result.returncode == 0, result.stderr
-    for suffix, size in ((".h5", 10_000), (".png", 10_000), (".html", 50_000)):
+    for suffix, size in ((".h5", 10_000), (".png", 10_000), ("_flight.png", 30_000), (".html", 50_000)):
         assert (tmp_path / f"{name}{suffix}").stat().st_size > size
+    plot = [sys.executable, "-m", "tumble", "plot", f"{out}.h5", "--what", "flight,paths", "-o", str(tmp_path)]
+    result = subprocess.run(plot, capture_output=True, text=True, timeout=280)
+    assert result.returncode == 0, result.stderr
+    assert (tmp_path / f"{name}_flight.png").stat().st_size > 30_000
