@@ -274,3 +274,20 @@ def test_thousand_boxes_for_600_frames_fit_the_budget_and_play(browser, tmp_path
     print(record)
     assert fps > 1.0 and drawn > 2
     assert page.errors == []
+
+
+def test_a_quadrotor_scene_draws_its_vehicles_arms_and_rotors(browser, tmp_path, artifacts):
+    from tumble import scene_file
+
+    loaded = scene_file.load(scene_file.shipped_scene("quadrotor_passing"))
+    trajectory = loaded.world.simulate(3.0, 0.01)
+    path = viewer.write_html(trajectory, tmp_path / "passing.html", world=loaded.world, title="two quadrotors")
+    page = open_replay(browser, path)
+    # Per vehicle: the hub (a box), four arms (boxes), four feet (spheres) and four rotor discs (cylinders).
+    assert page.evaluate("window.tumbleReplay.batches") == {"box": 10, "sphere": 8, "cylinder": 8, "plane": 1}
+    page.evaluate("window.tumbleReplay.setTime(2.0)")
+    next_frames(page)
+    pixels = canvas_pixels(page)
+    assert colourful_pixels(pixels) > 100
+    page.screenshot(path=str(artifacts / "replay_quadrotors.png"))
+    assert page.errors == []

@@ -96,7 +96,28 @@ def scene_geometry(world) -> dict:
         if mesh is not None:
             entry["mesh"] = mesh
         shapes.append(entry)
+    shapes += _vehicle_parts(world)
     return {"body_count": int(model.body_count), "shapes": shapes, "meshes": meshes}
+
+
+def _vehicle_parts(world) -> list[dict]:
+    """What the replay draws of a quadrotor besides its collision shapes: an arm from its centre to each hub and
+    a rotor disc over each hub (of 0.55 arm lengths, about a Crazyflie's propeller); drawn only. Positions are
+    in the body frame from its origin, as the rotors' (a quadrotor's origin is its centre of mass)."""
+    parts = []
+    for quad in world._vehicles:
+        i, arm = quad.body.index, quad.params["arm_length"]
+        for rotor in quad.rotors:
+            hub = np.asarray(rotor.position, dtype=float)
+            heading = float(np.arctan2(hub[1], hub[0]))
+            turn = [float(np.cos(heading / 2)), 0.0, 0.0, float(np.sin(heading / 2))]  # x onto the arm
+            length = float(np.hypot(hub[0], hub[1]))
+            parts.append({"body": i, "kind": "box", "size": [0.5 * length, 0.06 * arm, 0.04 * arm],
+                          "position": (0.5 * hub).tolist(), "quat": turn})  # fmt: skip
+            disc = (hub + (0.0, 0.0, 0.12 * arm)).tolist()
+            parts.append({"body": i, "kind": "cylinder", "size": [0.55 * arm, 0.015 * arm], "position": disc,
+                          "quat": [1.0, 0.0, 0.0, 0.0]})  # fmt: skip
+    return parts
 
 
 def fallback_geometry(body_mass: np.ndarray, body_inertia: np.ndarray, body_com_local: np.ndarray) -> dict:
