@@ -276,18 +276,39 @@ def test_thousand_boxes_for_600_frames_fit_the_budget_and_play(browser, tmp_path
     assert page.errors == []
 
 
-def test_a_quadrotor_scene_draws_its_vehicles_arms_and_rotors(browser, tmp_path, artifacts):
-    from tumble import scene_file
+def test_a_quadrotor_scene_draws_its_vehicles_arms_rotors_and_paths(browser, tmp_path, artifacts):
+    from tumble import recording, scene_file
 
     loaded = scene_file.load(scene_file.shipped_scene("quadrotor_passing"))
-    trajectory = loaded.world.simulate(3.0, 0.01)
+    trajectory = recording.record(loaded.world, 3.0, 0.01, tmp_path / "passing.h5")
     path = viewer.write_html(trajectory, tmp_path / "passing.html", world=loaded.world, title="two quadrotors")
     page = open_replay(browser, path)
-    # Per vehicle: the hub (a box), four arms (boxes), four feet (spheres) and four rotor discs (cylinders).
-    assert page.evaluate("window.tumbleReplay.batches") == {"box": 10, "sphere": 8, "cylinder": 8, "plane": 1}
+    # Per vehicle: four feet (spheres) and rotor discs (cylinders); boxes: the hub, four arms, four blades, and the
+    # bars of its reference path.
+    batches = page.evaluate("window.tumbleReplay.batches")
+    assert batches["sphere"] == 8 and batches["cylinder"] == 8 and batches["box"] > 2 * 9 + 2 * 250
     page.evaluate("window.tumbleReplay.setTime(2.0)")
     next_frames(page)
     pixels = canvas_pixels(page)
-    assert colourful_pixels(pixels) > 100
+    assert colourful_pixels(pixels) > 300  # the red paths and the vehicles
     page.screenshot(path=str(artifacts / "replay_quadrotors.png"))
+    assert page.errors == []
+
+
+def test_a_hovering_quadrotors_blades_turn(browser, tmp_path):
+    """At the end of the tilt recovery the vehicle hovers still (it moves 1e-5 m in 20 ms): what changes on the
+    screen between two instants is its blades turning."""
+    from tumble import recording, scene_file
+
+    loaded = scene_file.load(scene_file.shipped_scene("quadrotor_tilt_recovery"))
+    trajectory = recording.record(loaded.world, 5.0, 0.002, tmp_path / "hover.h5", every=5)
+    path = viewer.write_html(trajectory, tmp_path / "hover.html", world=loaded.world, title="hover")
+    page = open_replay(browser, path)
+    shots = []
+    for t in (4.90, 4.92, 4.92):
+        page.evaluate(f"window.tumbleReplay.setTime({t})")
+        next_frames(page)
+        shots.append(canvas_pixels(page))
+    assert changed(shots[1], shots[2]) == 0.0  # the same instant draws the same picture
+    assert changed(shots[0], shots[1]) > 5e-3  # 1.4 % of the pixels; 0.06 % with the blades held still
     assert page.errors == []

@@ -41,6 +41,18 @@ def _geometry_for(trajectory, world, geometry) -> dict:
     )
 
 
+def _channels_for(trajectory, world) -> dict:
+    """The recording's channels; where a vehicle of ``world`` has no reference there, its flight's trajectory at
+    the recorded times (a ``world.simulate`` recording has no channels)."""
+    channels = dict(trajectory.channels)
+    for quad in getattr(world, "_vehicles", ()):
+        key = f"vehicle/{quad.body.name or f'#{quad.body.index}'}/reference"
+        if key not in channels and quad._flight is not None:
+            reference = quad._flight.trajectory
+            channels[key] = np.array([reference(t)["position"] for t in trajectory.time])
+    return channels
+
+
 def replay_html(trajectory, *, world=None, geometry=None, title=None, max_frames=None, compress=True) -> str:
     """The replay page of ``trajectory`` as HTML text.
 
@@ -73,6 +85,7 @@ def replay_html(trajectory, *, world=None, geometry=None, title=None, max_frames
         title=title,
         max_frames=None if max_frames is None else int(max_frames),
         compress=bool(compress),
+        channels=_channels_for(trajectory, world),
     )
     return render_page(data)
 

@@ -96,17 +96,22 @@ def scene_geometry(world) -> dict:
         if mesh is not None:
             entry["mesh"] = mesh
         shapes.append(entry)
-    shapes += _vehicle_parts(world)
-    return {"body_count": int(model.body_count), "shapes": shapes, "meshes": meshes}
+    parts, vehicles = _vehicle_parts(world)
+    return {"body_count": int(model.body_count), "shapes": shapes + parts, "meshes": meshes, "vehicles": vehicles}
 
 
-def _vehicle_parts(world) -> list[dict]:
-    """What the replay draws of a quadrotor besides its collision shapes: an arm from its centre to each hub and
-    a rotor disc over each hub (of 0.55 arm lengths, about a Crazyflie's propeller); drawn only. Positions are
-    in the body frame from its origin, as the rotors' (a quadrotor's origin is its centre of mass)."""
-    parts = []
+# Rotor discs and blades of the drawn quadrotors, in arm lengths: about a Crazyflie's propeller.
+_ROTOR_RADIUS, _ROTOR_LIFT = 0.55, 0.12
+
+
+def _vehicle_parts(world) -> tuple[list[dict], list[dict]]:
+    """What the replay draws of each quadrotor besides its collision shapes: an arm from its centre to each hub
+    and a rotor disc over each hub (drawn only; positions in the body frame from its origin, as the rotors'), and
+    the vehicle itself (body, name, hubs, spins, rotor radius) for its blades and reference path."""
+    parts, vehicles = [], []
     for quad in world._vehicles:
         i, arm = quad.body.index, quad.params["arm_length"]
+        hubs = []
         for rotor in quad.rotors:
             hub = np.asarray(rotor.position, dtype=float)
             heading = float(np.arctan2(hub[1], hub[0]))
@@ -114,10 +119,13 @@ def _vehicle_parts(world) -> list[dict]:
             length = float(np.hypot(hub[0], hub[1]))
             parts.append({"body": i, "kind": "box", "size": [0.5 * length, 0.06 * arm, 0.04 * arm],
                           "position": (0.5 * hub).tolist(), "quat": turn})  # fmt: skip
-            disc = (hub + (0.0, 0.0, 0.12 * arm)).tolist()
-            parts.append({"body": i, "kind": "cylinder", "size": [0.55 * arm, 0.015 * arm], "position": disc,
-                          "quat": [1.0, 0.0, 0.0, 0.0]})  # fmt: skip
-    return parts
+            disc = hub + (0.0, 0.0, _ROTOR_LIFT * arm)
+            parts.append({"body": i, "kind": "cylinder", "size": [_ROTOR_RADIUS * arm, 0.015 * arm],
+                          "position": disc.tolist(), "quat": [1.0, 0.0, 0.0, 0.0]})  # fmt: skip
+            hubs.append((disc + (0.0, 0.0, 0.03 * arm)).tolist())
+        vehicles.append({"body": i, "name": quad.body.name or f"#{i}", "hubs": hubs,
+                         "spins": [float(r.spin) for r in quad.rotors], "radius": _ROTOR_RADIUS * arm})  # fmt: skip
+    return parts, vehicles
 
 
 def fallback_geometry(body_mass: np.ndarray, body_inertia: np.ndarray, body_com_local: np.ndarray) -> dict:

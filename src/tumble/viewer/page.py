@@ -107,8 +107,10 @@ def _view_bounds(
     return np.min([b[0] for b in boxes], axis=0), np.max([b[1] for b in boxes], axis=0)
 
 
-def build_data(trajectory, geometry: dict, *, title: str, max_frames: int | None = None, compress: bool = True):
-    """The JSON-ready dict the page's script reads (arrays as blobs, see :func:`encode_array`)."""
+def build_data(trajectory, geometry: dict, *, title: str, max_frames: int | None = None, compress: bool = True,
+               channels: dict | None = None):  # fmt: skip
+    """The JSON-ready dict the page's script reads (arrays as blobs, see :func:`encode_array`); ``channels`` (the
+    recording's, or made up from the world) give the quadrotors' reference paths and rotor speeds."""
     n = trajectory.body_count
     check_geometry(geometry, n)
     frames = select_frames(len(trajectory), max_frames)
@@ -135,6 +137,10 @@ def build_data(trajectory, geometry: dict, *, title: str, max_frames: int | None
     def blob(values, dtype):
         return encode_array(values, dtype, compress=compress)
 
+    overlays, path_points = _vehicle_overlays(trajectory, geometry, channels or {}, frames, blob)
+    if len(path_points):  # the camera also frames the paths the vehicles are to fly
+        view_lo, view_hi = np.minimum(view_lo, path_points.min(axis=0)), np.maximum(view_hi, path_points.max(axis=0))
+
     meshes = [{"vertices": blob(m["vertices"], "f4"), "faces": blob(m["faces"], "u4")} for m in geometry["meshes"]]
     shapes = [{k: v for k, v in s.items()} for s in geometry["shapes"] if s["kind"] != "plane"]
     return {
@@ -156,9 +162,42 @@ def build_data(trajectory, geometry: dict, *, title: str, max_frames: int | None
         "shapes": shapes,
         "meshes": meshes,
         "planes": planes,
+        **overlays,
         "bounds": {"min": lo.tolist(), "max": hi.tolist()},
         "view": {"min": view_lo.tolist(), "max": view_hi.tolist()},
     }
+
+
+# A blade drawn at the rotor's true speed (300 turns a second) would strobe: it turns at this fraction of it.
+BLADE_SLOWDOWN = 1.0 / 40.0
+_PATH_POINTS = 400  # the reference path is drawn with at most this many points
+
+
+def _vehicle_overlays(
+    trajectory, geometry: dict, channels: dict, frames: np.ndarray, encode
+) -> tuple[dict, np.ndarray]:
+    """The quadrotors' reference paths (``paths``: body and points) and spinning blades (``rotors``: body, hub in
+    the body frame, radius and the blade's angle at each frame), from the vehicle channels of the recording; and
+    every path point drawn, (P, 3)."""
+    paths, rotors, drawn = [], [], [np.zeros((0, 3))]
+    time = np.asarray(trajectory.time, dtype=float)
+    for vehicle in geometry.get("vehicles", []):
+        prefix = f"vehicle/{vehicle['name']}/"
+        reference = channels.get(prefix + "reference")
+        if reference is not None:
+            points = reference[np.isfinite(reference).all(axis=1)]
+            if len(points) >= 2:
+                points = points[np.unique(np.linspace(0, len(points) - 1, _PATH_POINTS).astype(int))]
+                paths.append({"body": vehicle["body"], "points": encode(points, "f4")})
+                drawn.append(points)
+        speeds = channels.get(prefix + "rotor_speeds")
+        for k, (hub, spin) in enumerate(zip(vehicle["hubs"], vehicle["spins"], strict=True)):
+            angle = np.zeros(len(time))
+            if speeds is not None:  # the trapezoid rule over the frames, the blade turning the way its rotor does
+                angle[1:] = np.cumsum(0.5 * (speeds[1:, k] + speeds[:-1, k]) * np.diff(time))
+            rotors.append({"body": vehicle["body"], "hub": hub, "radius": vehicle["radius"],
+                           "angles": encode(-spin * BLADE_SLOWDOWN * angle[frames], "f4")})  # fmt: skip
+    return {"paths": paths, "rotors": rotors}, np.concatenate(drawn)
 
 
 def _names(trajectory, n: int) -> list[str]:

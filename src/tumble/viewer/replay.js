@@ -299,6 +299,8 @@ void main() {
   }
   const STATIC_COLOR = [0.6, 0.63, 0.68];
   const PLANE_COLOR = [0.8, 0.82, 0.85];
+  const PATH_COLOR = [0.85, 0.25, 0.2];
+  const BLADE_COLOR = [0.15, 0.15, 0.18];
 
   function softwareRenderer() {
     try {
@@ -321,6 +323,9 @@ void main() {
       ["time", "kinetic", "potential", "restPos", "restQuat", "moving", "pos", "quat", "speed"].map((k) => decode(data[k])));
     const meshes = await Promise.all(data.meshes.map(async (m) => ({
       vertices: await decode(m.vertices), faces: await decode(m.faces) })));
+    // Quadrotors: their reference paths (world points) and their blades (an angle per frame).
+    const paths = await Promise.all((data.paths || []).map(async (p) => ({ body: p.body, points: await decode(p.points) })));
+    const rotors = await Promise.all((data.rotors || []).map(async (r) => ({ ...r, angles: await decode(r.angles) })));
     const N = data.bodyCount, T = data.frameCount;
     const slot = new Int32Array(N).fill(-1);
     moving.forEach((body, m) => { slot[body] = m; });
@@ -398,6 +403,28 @@ void main() {
       batch.instances.push({ body: plane.body, world: true, pose: [...plane.center, ...plane.quat],
         scale: [plane.half, plane.half, 1, 0], color: PLANE_COLOR });
     }
+    // A reference path: thin bars from point to point, fixed in the world (picking one picks its vehicle).
+    const pathWidth = 0.002 * viewSize;
+    for (const path of paths) {
+      const batch = batchFor("box", () => unit.box), p = path.points;
+      for (let k = 0; k + 5 < p.length; k += 3) {
+        const a = [p[k], p[k + 1], p[k + 2]], d = [p[k + 3] - a[0], p[k + 4] - a[1], p[k + 5] - a[2]];
+        const length = Math.hypot(d[0], d[1], d[2]);
+        if (!(length > 0)) continue;
+        // The rotation taking x onto d: axis x × d, half the angle (a half turn about z when d is -x).
+        const w = 1 + d[0] / length, q = w > 1e-9 ? [w, 0, -d[2] / length, d[1] / length] : [0, 0, 0, 1];
+        const qn = Math.hypot(...q);
+        batch.instances.push({ body: path.body, world: true,
+          pose: [a[0] + 0.5 * d[0], a[1] + 0.5 * d[1], a[2] + 0.5 * d[2], ...q.map((v) => v / qn)],
+          scale: [0.5 * length, pathWidth, pathWidth, 0], color: PATH_COLOR });
+      }
+    }
+    // A blade over each rotor disc, turned about the body's z at its hub by the rotor's angle (updatePoses).
+    rotors.forEach((rotor, k) => {
+      batchFor("box", () => unit.box).instances.push({ body: rotor.body, world: false, spin: k,
+        pose: [...rotor.hub, 1, 0, 0, 0], scale: [rotor.radius, 0.12 * rotor.radius, 0.02 * rotor.radius, 0],
+        color: BLADE_COLOR });
+    });
     // Per-instance buffers: static [shape pos 3, shape quat 4, scale 4, colour 3 + body id] and
     // dynamic [body pos 3, body quat 4] (rewritten whenever the shown time changes).
     for (const batch of batches.values()) {
@@ -466,12 +493,25 @@ void main() {
       }
       for (const batch of batches.values()) {
         batch.instances.forEach((inst, k) => {
-          if (inst.world) batch.poses.set([0, 0, 0, 1, 0, 0, 0], k * 7);
+          if (inst.spin !== undefined) batch.poses.set(bladePose(inst.body, rotors[inst.spin], f, g, a), k * 7);
+          else if (inst.world) batch.poses.set([0, 0, 0, 1, 0, 0, 0], k * 7);
           else batch.poses.set(poses.subarray(inst.body * 7, inst.body * 7 + 7), k * 7);
         });
         gl.bindBuffer(gl.ARRAY_BUFFER, batch.dynamic);
         gl.bufferSubData(gl.ARRAY_BUFFER, 0, batch.poses);
       }
+    }
+
+    // The pose that turns a blade placed at ``hub`` (in its body's frame) by its angle about the body's z at the
+    // hub: the body's pose composed with the turn R_z(θ) about the hub, p = x_b + R_b (h - R_z h), q = q_b ⊗ q_z.
+    function bladePose(body, rotor, f, g, a) {
+      const theta = rotor.angles[f] + a * (rotor.angles[g] - rotor.angles[f]);
+      const c = Math.cos(theta), s = Math.sin(theta), h = rotor.hub;
+      const b = poses.subarray(body * 7, body * 7 + 7), bq = [b[3], b[4], b[5], b[6]];
+      const shift = quatRotate(bq, [h[0] - (c * h[0] - s * h[1]), h[1] - (s * h[0] + c * h[1]), 0]);
+      const hw = Math.cos(theta / 2), hz = Math.sin(theta / 2);
+      return [b[0] + shift[0], b[1] + shift[1], b[2] + shift[2],
+        bq[0] * hw - bq[3] * hz, bq[1] * hw + bq[2] * hz, bq[2] * hw - bq[1] * hz, bq[3] * hw + bq[0] * hz];
     }
 
     function eye() {
