@@ -7,8 +7,7 @@ The flight: RotorPy's Crazyflie (``tumble.vehicles.CRAZYFLIE``), from rest at th
 gains) called at every step, for ``quadrotor_seconds`` of simulated time, at 100 Hz and at 500 Hz:
 
 - tumble: ``quad.fly(SE3Controller(quad), Lissajous(...))`` and ``world.simulate`` (its default integrator, RK4
-  over each step with the motors' exact lag); the controller is compiled (``tumble/flight/kernels.py``), the step
-  loop runs from Python because a controller must run between steps.
+  over each step with the motors' exact lag); the flight runs inside the compiled loop (``tumble/flight/native.py``).
 - tumble with ``CascadedPID``: a controller in plain Python and NumPy, no compiled code of its own, as a user's
   callback would be.
 - tumble with no controller, the rotors at fixed speeds: the compiled loop alone, the engine's floor.
@@ -126,7 +125,7 @@ def bench_quadrotor(sizes) -> list[dict]:
     repeat = min(sizes.repeat, 3)
     rows = []
     for rate in RATES:
-        for controller, label in (("se3", "SE3Controller (compiled)"), ("cascaded", "CascadedPID (Python)"),
+        for controller, label in (("se3", "SE3Controller (in the loop)"), ("cascaded", "CascadedPID (Python)"),
                                   ("none", "none (compiled loop)")):  # fmt: skip
             tumble_figure_eight(rate, min(seconds, 0.1), controller)  # compile or load from the cache
             runs = [tumble_figure_eight(rate, seconds, controller) for _ in range(repeat)]

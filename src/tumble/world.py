@@ -575,7 +575,11 @@ class World:
         t0, initial = self._state.time, self._state.copy()
         recording = Trajectory.allocate_recording(self._state.body_count, n_steps // record_every)
         controller_error = None
-        if self._controllers or self._sensors or not isinstance(self._wind, (Constant, type(None))):
+        flights = self._native_flights()
+        if flights is not None:
+            steps_done, failing, controller_error = self._simulate_flights(flights, dt, n_steps, recording,
+                                                                           int(record_every))  # fmt: skip
+        elif self._controllers or self._sensors or not isinstance(self._wind, (Constant, type(None))):
             steps_done, failing, controller_error = self._simulate_stepwise(dt, n_steps, recording, int(record_every))
         else:
             steps_done, failing = simulate_steps(
@@ -599,6 +603,60 @@ class World:
             error.trajectory = trajectory
             raise error
         return trajectory
+
+    def _native_flights(self):
+        """The table of the world's controllers when every one is a flight the compiled loop runs itself
+        (``tumble.flight.native``: SE(3) on a known reference) and nothing else needs Python between the steps
+        (no sensors, a constant wind, no contacts or joints); else None."""
+        if not self._controllers or self._sensors or not isinstance(self._wind, (Constant, type(None))):
+            return None
+        if self.model.has_constraints:
+            return None
+        from .flight.native import flight_table
+
+        self._actuation.for_bodies(self._model.body_com_local)  # the rotors' rows in the arrays
+        return flight_table(self, list(self._controllers))
+
+    def _simulate_flights(self, table, dt: float, n_steps: int, recording, record_every: int):
+        """All the steps in one compiled call with the flights of ``table`` between them: ``(steps_done,
+        failing_body, error)`` as :meth:`_simulate_stepwise`."""
+        from .flight.native import fly_steps
+        from .pipeline import _advance_clock
+
+        acts = self._actuators_for_step(dt)
+        self._next_step_time(dt)  # rebase the counted clock if it must be
+        origin_time, origin_step, _ = self._clock._origin
+        model, state, inputs, scratch = self._model, self._state, self._inputs, self._scratch
+        speeds = np.zeros(4)
+        steps, failing, flight = fly_steps(
+            table, model.body_arrays, model.gravity, inputs.body_force, inputs.body_torque,
+            np.zeros_like(inputs.body_force), acts, state.body_pos, state.body_quat, state.body_linvel,
+            state.body_angmom, scratch.backup, scratch.no_recording, recording, dt, n_steps,
+            int(self._params.resolve_integrator(False)), record_every, origin_time, state.step_count - origin_step,
+            np.zeros((4, 3)), speeds,
+        )  # fmt: skip
+        _advance_clock(state, dt, steps)
+        if steps > 0:
+            inputs.clear()
+        controllers = list(self._controllers)
+        for k, controller in enumerate(controllers):
+            controller.calls += int(table.calls[k])
+            controller._next_tick = int(table.next_tick[k])
+            integral = controller._flight.controller._integral
+            integral.value[:] = table.integral[k]
+            integral._last_time = None if np.isnan(table.last_time[k]) else float(table.last_time[k])
+        error = None
+        if flight >= 0:
+            name, t = controllers[flight].name, self._next_step_time(dt)
+            law = type(controllers[flight]._flight.controller).__name__
+            error = SimulationError(
+                f"controller {name!r} raised ValueError: {law}.update returned {speeds.tolist()!r} at t = {t:.6g} s, "
+                f"not four finite rotor speeds at t = {t:.6g} s (before step {state.step_count}); the world keeps "
+                "its state from before that step",
+                step=state.step_count,
+                controller=name,
+            )  # fmt: skip
+        return steps, failing, error
 
     def _simulate_stepwise(self, dt: float, n_steps: int, recording, record_every: int):
         """Step by step from Python, the controllers before each step and the sensors after it: ``(steps_done,

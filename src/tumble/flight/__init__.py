@@ -308,6 +308,7 @@ class Flight(NamedTuple):
     trajectory: object
     rate: float | None
     handle: object
+    quad: object
 
 
 def fly(quad, controller, trajectory, rate: float | None = None):
@@ -327,5 +328,5 @@ def fly(quad, controller, trajectory, rate: float | None = None):
         quad.command_rotor_speeds(speeds)
 
     handle = quad.world.add_controller(follow, rate=rate, name=name)
-    quad._flight = Flight(controller, trajectory, rate, handle)
+    quad._flight = handle._flight = Flight(controller, trajectory, rate, handle, quad)
     return handle

@@ -1,0 +1,253 @@
+"""Flights inside the compiled loop: ``world.simulate`` of free-flying vehicles whose only controllers are
+``quad.fly(SE3Controller(...), Hover | Circle | Lissajous | MinimumSnap)`` runs all its steps in one kernel call,
+the controllers at their ticks between the steps, instead of one Python round trip per step.
+
+It does what the step-by-step path does, in the same order: at each step's counted start time ``t0 + s h`` the
+flights that are due evaluate their reference and the SE(3) law (the same kernel) and command their rotors; every
+body takes one step of the same integrator (``_advance_body`` with one step); the motors advance by ``h``. The two
+paths agree to round-off (the references' sines are the only difference: ``math`` here, NumPy there).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import NamedTuple
+
+import numpy as np
+
+from .._jit import kernel
+from ..dynamics.actuation import advance_motors
+from ..dynamics.integrate import _advance_body
+from ..math3d import store3, store4
+from ..references import Circle, Hover, Lissajous, MinimumSnap
+from . import SE3Controller
+from .kernels import se3_rotor_speeds
+
+__all__ = ["FlightTable", "flight_table", "fly_steps"]
+
+_HOVER, _CIRCLE, _LISSAJOUS, _MINIMUM_SNAP = 0, 1, 2, 3
+_TICK_TOLERANCE = 1e-9  # as tumble.control's: a tick within a billionth of a step counts as reached
+
+
+class FlightTable(NamedTuple):
+    """Every native flight of a world, one row each (``f`` rows); the references' parameters padded."""
+
+    body: np.ndarray  # (f,) int64
+    rows: np.ndarray  # (f, 4) int64: the rotors' rows in the actuator arrays
+    speed_min: np.ndarray  # (f, 4)
+    speed_max: np.ndarray  # (f, 4)
+    rate: np.ndarray  # (f,) Hz; 0: every step
+    next_tick: np.ndarray  # (f,) int64, the index k of the next tick k / rate (written back)
+    calls: np.ndarray  # (f,) int64, calls made in this run (written back)
+    mass: np.ndarray  # (f,)
+    inertia: np.ndarray  # (f, 3, 3)
+    inv_inertia: np.ndarray  # (f, 3, 3)
+    gains: np.ndarray  # (f, 12): kp_pos (3), kd_pos (3), ki_pos (3), kp_att, kd_att, integral_limit
+    feedforward: np.ndarray  # (f,) bool
+    integral: np.ndarray  # (f, 3): the position error's integral (written back)
+    last_time: np.ndarray  # (f,): the time of the integral's last update, NaN before the first (written back)
+    mixer_inverse: np.ndarray  # (f, 4, 4)
+    k_thrust: np.ndarray  # (f,)
+    squared_limits: np.ndarray  # (f, 2)
+    kind: np.ndarray  # (f,) int64: _HOVER, _CIRCLE, _LISSAJOUS, _MINIMUM_SNAP
+    params: np.ndarray  # (f, 11): see _reference_row
+    knot_count: np.ndarray  # (f,) int64: MinimumSnap's waypoints
+    knots: np.ndarray  # (f, k): MinimumSnap's times, padded
+    coefficients: np.ndarray  # (f, k - 1, 8, 3): MinimumSnap's pieces, padded
+
+
+def _reference_row(trajectory) -> tuple[int, np.ndarray, np.ndarray, np.ndarray] | None:
+    """``(kind, params (11,), knots, coefficients)`` of a trajectory the kernel evaluates; None for others.
+
+    ``params``: [0:3] the position (hover) or centre, then circle: radius, frequency; Lissajous: A, B, a, b, delta;
+    [10] the yaw. ``knots`` and ``coefficients``: MinimumSnap's times and pieces."""
+    params = np.zeros(11)
+    knots, coefficients = np.array([0.0]), np.zeros((0, 8, 3))
+    kind = type(trajectory)
+    if kind is Hover:
+        params[:3] = trajectory.position
+        code = _HOVER
+    elif kind is Circle:
+        params[:5] = (*trajectory.center, trajectory.radius, trajectory.frequency)
+        code = _CIRCLE
+    elif kind is Lissajous:
+        t = trajectory
+        params[:8] = (*t.center, t.A, t.B, t.a, t.b, t.delta)
+        code = _LISSAJOUS
+    elif kind is MinimumSnap:
+        knots, coefficients = trajectory.times, trajectory._coefficients
+        code = _MINIMUM_SNAP
+    else:
+        return None
+    params[10] = trajectory.yaw
+    return code, params, knots, coefficients
+
+
+def flight_table(world, controllers) -> FlightTable | None:
+    """The native flights behind ``controllers`` (the world's, in order); None when one of them is not a flight
+    the kernel can run (an SE(3) controller on a known reference, its vehicle's rotors in the actuator arrays)."""
+    rows = []
+    for controller in controllers:
+        flight = getattr(controller, "_flight", None)
+        if flight is None or type(flight.controller) is not SE3Controller:
+            return None
+        reference = _reference_row(flight.trajectory)
+        if reference is None:
+            return None
+        quad, law = flight.quad, flight.controller
+        owner = quad.rotors[0]._owner
+        if owner is None or any(r._owner is not owner for r in quad.rotors):
+            return None
+        rows.append((quad, law, controller, reference))
+    if not rows:
+        return None
+    size = max(len(r[3][2]) for r in rows)
+    table = FlightTable(
+        body=np.array([q.body.index for q, *_ in rows], np.int64),
+        rows=np.array([[rotor._row for rotor in q.rotors] for q, *_ in rows], np.int64),
+        speed_min=np.array([[rotor.speed_min for rotor in q.rotors] for q, *_ in rows], float),
+        speed_max=np.array([[rotor.speed_max for rotor in q.rotors] for q, *_ in rows], float),
+        rate=np.array([c.rate or 0.0 for _, _, c, _ in rows], float),
+        next_tick=np.array([c._next_tick for _, _, c, _ in rows], np.int64),
+        calls=np.zeros(len(rows), np.int64),
+        mass=np.array([q.params["mass"] for q, *_ in rows], float),
+        inertia=np.array([q.params["inertia"] for q, *_ in rows], float),
+        inv_inertia=np.array([law._inv_inertia for _, law, *_ in rows], float),
+        gains=np.array(
+            [
+                [*law.kp_pos, *law.kd_pos, *law.ki_pos, law.kp_att, law.kd_att, law.integral_limit]
+                for _, law, *_ in rows
+            ],
+            float,
+        ),  # fmt: skip
+        feedforward=np.array([law.feedforward for _, law, *_ in rows], np.bool_),
+        integral=np.array([law._integral.value for _, law, *_ in rows], float),
+        last_time=np.array(
+            [math.nan if law._integral._last_time is None else law._integral._last_time for _, law, *_ in rows], float
+        ),  # fmt: skip
+        mixer_inverse=np.array([q.mixer.inverse for q, *_ in rows], float),
+        k_thrust=np.array([q.params["k_thrust"] for q, *_ in rows], float),
+        squared_limits=np.array([q.mixer.squared_limits for q, *_ in rows], float),
+        kind=np.array([r[3][0] for r in rows], np.int64),
+        params=np.array([r[3][1] for r in rows], float),
+        knot_count=np.array([len(r[3][2]) for r in rows], np.int64),
+        knots=np.array([np.pad(r[3][2], (0, size - len(r[3][2]))) for r in rows], float),
+        coefficients=np.array(
+            [np.pad(r[3][3], ((0, max(size - 1, 1) - len(r[3][3])), (0, 0), (0, 0))) for r in rows], float
+        ),  # fmt: skip
+    )
+    return table
+
+
+@kernel
+def _reference(kind, params, knot_count, knots, coefficients, t, out):
+    """The reference's position, velocity, acceleration and jerk at ``t`` into ``out`` (4, 3) (tumble.references'
+    formulas)."""
+    out[:, :] = 0.0
+    if kind == _HOVER:
+        out[0, :] = params[:3]
+    elif kind == _CIRCLE:
+        r, w = params[3], 2.0 * math.pi * params[4]
+        phase = w * t
+        c, s = math.cos(phase), math.sin(phase)
+        out[0, 0], out[0, 1], out[0, 2] = params[0] + r * c, params[1] + r * s, params[2]
+        out[1, 0], out[1, 1] = -r * w * s, r * w * c
+        out[2, 0], out[2, 1] = -r * w**2 * c, -r * w**2 * s
+        out[3, 0], out[3, 1] = r * w**3 * s, -r * w**3 * c
+    elif kind == _LISSAJOUS:
+        A, B, a, b, delta = params[3], params[4], params[5], params[6], params[7]
+        for k in range(4):
+            out[k, 0] = A * a**k * math.sin(a * t + delta + k * (math.pi / 2))
+            out[k, 1] = B * b**k * math.sin(b * t + k * (math.pi / 2))
+        out[0, :] += params[:3]
+    else:
+        last = knot_count - 1
+        if t < knots[0] or t > knots[last]:  # waiting at an end
+            piece, s = (0, 0.0) if t < knots[0] else (last - 1, 1.0)
+            for axis in range(3):
+                value = 0.0
+                for k in range(8):
+                    value += coefficients[piece, k, axis] * s**k
+                out[0, axis] = value
+            return
+        piece = 0
+        while piece < last - 1 and knots[piece + 1] <= t:
+            piece += 1
+        duration = knots[piece + 1] - knots[piece]
+        s = (t - knots[piece]) / duration
+        for derivative in range(4):
+            for axis in range(3):
+                value = 0.0
+                for k in range(derivative, 8):
+                    factor = 1.0
+                    for m in range(k - derivative + 1, k + 1):
+                        factor *= m
+                    value += factor * s ** (k - derivative) * coefficients[piece, k, axis]
+                out[derivative, axis] = value / duration**derivative
+
+
+@kernel
+def fly_steps(table, bodies, gravity, force, torque, zero, acts, pos, quat, linvel, angmom, backup, no_recording, rec,
+              h, n_steps, method, record_every, origin_time, origin_count, ref, speeds):  # fmt: skip
+    """``n_steps`` steps of ``h``: before each, the flights that are due command their rotors; then every body one
+    step, the motors ``h`` on, the frame recorded. The step ``s`` starts at ``origin_time + (origin_count + s) h``,
+    as ``tumble.control.StepClock`` counts. Returns ``(steps_done, failing_body, failing_flight)`` (-1: none); on a
+    failure the bodies are as before that step, and ``speeds`` holds what a failing flight asked for."""
+    flights = table.body.shape[0]
+    for s in range(n_steps):
+        t = origin_time + (origin_count + s) * h
+        for f in range(flights):
+            rate = table.rate[f]
+            if rate > 0.0 and t < table.next_tick[f] / rate - _TICK_TOLERANCE * h:
+                continue
+            _reference(table.kind[f], table.params[f], table.knot_count[f], table.knots[f], table.coefficients[f], t,
+                       ref)  # fmt: skip
+            b = table.body[f]
+            gains = table.gains[f]
+            integral = np.zeros(3)
+            if gains[6] > 0.0 or gains[7] > 0.0 or gains[8] > 0.0:  # tumble.flight._Integral
+                last = table.last_time[f]
+                if not math.isnan(last) and t > last:
+                    for k in range(3):
+                        value = table.integral[f, k] + (pos[b, k] - ref[0, k]) * (t - last)
+                        if gains[6 + k] > 0.0:
+                            bound = gains[11] / gains[6 + k]
+                            value = min(max(value, -bound), bound)
+                        table.integral[f, k] = value
+                table.last_time[f] = t
+                for k in range(3):
+                    integral[k] = gains[6 + k] * table.integral[f, k]
+            se3_rotor_speeds(pos[b], linvel[b], quat[b], angmom[b], table.inv_inertia[f], table.inertia[f],
+                             table.mass[f], gravity, ref, table.params[f, 10], 0.0, gains[0:3], gains[3:6], integral,
+                             gains[9], gains[10], table.feedforward[f], table.mixer_inverse[f], table.k_thrust[f],
+                             table.squared_limits[f, 0], table.squared_limits[f, 1], speeds)  # fmt: skip
+            for k in range(4):
+                if not math.isfinite(speeds[k]):
+                    return s, -1, f
+            for k in range(4):
+                acts.command[table.rows[f, k]] = min(max(speeds[k], table.speed_min[f, k]), table.speed_max[f, k])
+            table.calls[f] += 1
+            if rate > 0.0:
+                table.next_tick[f] = max(table.next_tick[f] + 1, math.floor((t + _TICK_TOLERANCE * h) * rate) + 1)
+        body_count = pos.shape[0]
+        for i in range(body_count):
+            store3(backup[0], i, (pos[i, 0], pos[i, 1], pos[i, 2]))
+            store4(backup[1], i, (quat[i, 0], quat[i, 1], quat[i, 2], quat[i, 3]))
+            store3(backup[2], i, (linvel[i, 0], linvel[i, 1], linvel[i, 2]))
+            store3(backup[3], i, (angmom[i, 0], angmom[i, 1], angmom[i, 2]))
+        for i in range(body_count):
+            if not bodies.is_dynamic[i]:
+                continue
+            loads_f, loads_t = (force, torque) if s == 0 else (zero, zero)
+            if _advance_body(i, bodies, gravity, loads_f, loads_t, acts, pos, quat, linvel, angmom, no_recording, h,
+                             1, method, 0) >= 0:  # fmt: skip
+                pos[:, :], quat[:, :], linvel[:, :], angmom[:, :] = backup[0], backup[1], backup[2], backup[3]
+                return s, i, -1
+        advance_motors(acts, h)
+        if record_every > 0 and (s + 1) % record_every == 0:
+            frame = (s + 1) // record_every - 1
+            rec.pos[frame, :, :] = pos
+            rec.quat[frame, :, :] = quat
+            rec.linvel[frame, :, :] = linvel
+            rec.angmom[frame, :, :] = angmom
+    return n_steps, -1, -1

@@ -1,0 +1,78 @@
+"""Flights inside the compiled loop (``tumble.flight.native``): ``world.simulate`` of free-flying vehicles flown by
+the SE(3) controller on a known reference takes all its steps in one kernel call, and flies exactly as the
+step-by-step path does."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import tumble
+from tumble.control import Circle, Hover, Lissajous, MinimumSnap, SE3Controller
+from tumble.vehicles import Quadrotor
+
+REFERENCES = [
+    (Lissajous(1.0, 0.5, 1.0, 2.0, center=(0.0, 0.0, 1.0)), {}),
+    (Circle((0.0, 0.0, 1.0), 1.0, 0.2), {"ki_pos": 1.0}),
+    (Hover((0.2, 0.0, 1.0)), {"ki_pos": 2.0}),
+    (MinimumSnap([(0, 0, 1), (1, 0, 1.5), (1, 1, 1)], average_speed=0.7), {"feedforward": True}),
+]
+
+
+def flight(reference, gains, rate, stepwise: bool, wind=None):
+    world = tumble.World()
+    world.wind = wind
+    quad = Quadrotor(world, position=reference(0.0)["position"])
+    quad.rotor_speeds = [quad.hover_rotor_speed] * 4
+    handle = quad.fly(SE3Controller(quad, **gains), reference, rate=rate)
+    if stepwise:  # a second controller that does nothing keeps simulate stepping from Python
+        world.add_controller(lambda world, t: None, name="idle")
+    return world, quad, handle
+
+
+@pytest.mark.parametrize(("reference", "gains"), REFERENCES, ids=["lissajous", "circle", "hover", "minimum_snap"])
+@pytest.mark.parametrize("rate", [None, 100.0])
+def test_the_compiled_flight_is_the_stepwise_flight(reference, gains, rate):
+    runs = []
+    for stepwise in (False, True):
+        world, quad, handle = flight(reference, gains, rate, stepwise, wind=(1.0, 0.5, 0.0))
+        recording = world.simulate(3.0, 0.002, record_every=5)
+        world.simulate(0.5, 0.002)  # a second call carries the ticks and the integral on
+        runs.append((recording, world, quad, handle))
+    (a, wa, qa, ha), (b, wb, qb, hb) = runs
+    exact = type(reference) is not MinimumSnap  # its pieces are evaluated in another order: 1e-15 apart
+    tolerance = 0.0 if exact else 1e-12
+    np.testing.assert_allclose(a.position, b.position, rtol=0, atol=tolerance)
+    np.testing.assert_allclose(wa.state.body_pos, wb.state.body_pos, rtol=0, atol=tolerance)
+    np.testing.assert_allclose(qa.commanded_rotor_speeds, qb.commanded_rotor_speeds, rtol=1e-12)
+    assert ha.calls == hb.calls == (1750 if rate is None else 350)
+    assert wa.time == wb.time and wa.step_count == wb.step_count
+    np.testing.assert_allclose(qa._flight.controller._integral.value, qb._flight.controller._integral.value,
+                               rtol=0, atol=tolerance)  # fmt: skip
+
+
+def test_the_compiled_flight_is_used_only_where_it_can_run():
+    world, quad, _ = flight(Hover((0.0, 0.0, 1.0)), {}, None, stepwise=False)
+    assert world._native_flights() is not None
+    world.add_static(tumble.Plane())  # contacts: the step-by-step path
+    assert world._native_flights() is None
+    world, quad, _ = flight(Hover((0.0, 0.0, 1.0)), {}, None, stepwise=True)
+    assert world._native_flights() is None
+
+
+def test_a_body_that_fails_mid_run_stops_the_compiled_flight_as_the_stepwise_one_does():
+    """A shapeless body pushed by 2e307 N overflows after a few steps of 0.5 s: both paths stop at the same step,
+    every body as it was after the step before, the recording up to it."""
+    outcomes = []
+    for stepwise in (False, True):
+        world, quad, _ = flight(Hover((0.0, 0.0, 1.0)), {}, None, stepwise=stepwise)
+        rock = world.add_body(None, mass=1.0, inertia=np.eye(3), position=(5.0, 0.0, 1.0), name="rock")
+        rock.constant_force = (2e307, 0.0, 0.0)
+        assert (world._native_flights() is None) == stepwise
+        with pytest.raises(tumble.SimulationError, match=r"body 'rock' became non-finite") as error:
+            world.simulate(10.0, 0.5)
+        assert error.value.step == world.step_count > 0 and np.isfinite(world.state.body_pos).all()
+        assert len(error.value.trajectory) == world.step_count + 1
+        outcomes.append((world.step_count, world.state.body_pos.copy()))
+    assert outcomes[0][0] == outcomes[1][0]
+    np.testing.assert_array_equal(outcomes[0][1], outcomes[1][1])
