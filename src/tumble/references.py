@@ -10,6 +10,7 @@ frame, SI) and ``yaw`` [rad], ``yaw_rate`` [rad/s].
 from __future__ import annotations
 
 import math
+import warnings
 
 import numpy as np
 
@@ -155,7 +156,7 @@ class MinimumSnap:
         self._coefficients = self._solve()  # (segments, 8, 3) in the normalised time s = (t - t_i) / T_i
 
     def _solve(self) -> np.ndarray:
-        from scipy.linalg import solve
+        from scipy.linalg import LinAlgError, LinAlgWarning, solve
 
         segments = self.waypoints.shape[0] - 1
         durations = np.diff(self.times)
@@ -184,7 +185,16 @@ class MinimumSnap:
                 constrain(i, derivative, 1.0)
                 constrain(i + 1, derivative, 0.0, scale=-1.0)
                 row += 1
-        return solve(matrix, rhs).reshape(segments, _COEFFICIENTS, 3)
+        with warnings.catch_warnings():
+            warnings.simplefilter("error", LinAlgWarning)
+            try:
+                return solve(matrix, rhs).reshape(segments, _COEFFICIENTS, 3)
+            except (LinAlgWarning, LinAlgError) as error:
+                raise ValueError(
+                    f"times give segments of {durations.min():.3g} to {durations.max():.3g} s, too unequal to solve "
+                    "for (the continuity of the 6th derivative scales with the duration to the 6th power): space "
+                    "the times more evenly"
+                ) from error
 
     @property
     def duration(self) -> float:

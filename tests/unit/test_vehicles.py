@@ -249,6 +249,7 @@ def test_minimum_snap_is_stationary_for_every_admissible_change():
         ({"waypoints": [(0, 0, 0), (0, 0, 0)]}, "waypoints 0 and 1 are the same point"),
         ({"waypoints": [(0, 0, 0), (1, 0, 0)], "average_speed": 0.0}, "average_speed must be > 0"),
         ({"waypoints": [(0, 0, 0), (1, 0, float("inf"))]}, "waypoints must be finite"),
+        ({"waypoints": [(0, 0, 0), (1, 0, 0), (2, 0, 0)], "times": [0.0, 1e-6, 1e3]}, "too unequal to solve for"),
     ],
 )
 def test_minimum_snap_refuses_bad_input(kwargs, match):
