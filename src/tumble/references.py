@@ -11,17 +11,61 @@ from __future__ import annotations
 
 import math
 import warnings
+from typing import NamedTuple
 
 import numpy as np
 
 from ._validate import as_array, as_float, as_vector3
+from .flight.kernels import CIRCLE, HOVER, LISSAJOUS, MINIMUM_SNAP, reference_derivatives
 
 __all__ = ["Circle", "Hover", "Lissajous", "MinimumSnap"]
 
 _DERIVATIVES = ("position", "velocity", "acceleration", "jerk", "snap")
 
 
-_ORDERS = np.arange(5)
+class ReferenceSpec(NamedTuple):
+    """A reference as the compiled evaluator takes it (``flight.kernels.reference_derivatives``)."""
+
+    kind: int
+    params: np.ndarray  # (11,)
+    knot_count: int
+    knots: np.ndarray
+    coefficients: np.ndarray  # (pieces, 8, 3)
+
+
+_NO_KNOTS, _NO_PIECES = np.zeros(1), np.zeros((1, 8, 3))
+
+
+def _spec(kind: int, values: tuple, knots=_NO_KNOTS, coefficients=_NO_PIECES) -> ReferenceSpec:
+    """``values``: pairs of a place in ``params`` (an index or a slice) and what goes there."""
+    params = np.zeros(11)
+    for where, value in values:
+        params[where] = value
+    return ReferenceSpec(kind, params, len(knots), np.asarray(knots, float), np.asarray(coefficients, float))
+
+
+class _Reference:
+    """A reference evaluated by ``flight.kernels.reference_derivatives`` from its :class:`ReferenceSpec`. Immutable
+    once built (the spec is derived from the attributes): build a new one to change it."""
+
+    spec: ReferenceSpec
+    yaw: float
+
+    def _freeze(self) -> None:
+        for value in (*vars(self).values(), *self.spec):
+            if isinstance(value, np.ndarray):
+                value.flags.writeable = False
+        object.__setattr__(self, "_frozen", True)
+
+    def __setattr__(self, name, value) -> None:
+        if getattr(self, "_frozen", False):
+            raise AttributeError(f"{type(self).__name__} is immutable; cannot set {name!r} (build a new one instead)")
+        object.__setattr__(self, name, value)
+
+    def __call__(self, t) -> dict:
+        derivatives = np.empty((5, 3))
+        reference_derivatives(*self.spec, _time(t), derivatives)
+        return _flat_output(derivatives, self.yaw)
 
 
 def _flat_output(derivatives, yaw: float = 0.0, yaw_rate: float = 0.0) -> dict:
@@ -36,23 +80,20 @@ def _time(t) -> float:
     return as_float("t", t)
 
 
-class Hover:
+class Hover(_Reference):
     """Stay at ``position`` (3,) [m] facing ``yaw`` [rad]."""
 
     def __init__(self, position, yaw=0.0):
         self.position = as_vector3("position", position)
         self.yaw = as_float("yaw", yaw)
-
-    def __call__(self, t) -> dict:
-        _time(t)
-        zero = np.zeros(3)
-        return _flat_output((self.position, zero, zero, zero, zero), self.yaw)
+        self.spec = _spec(HOVER, ((slice(0, 3), self.position), (10, self.yaw)))
+        self._freeze()
 
     def __repr__(self) -> str:
         return f"Hover({self.position.tolist()}, yaw={self.yaw!r})"
 
 
-class Circle:
+class Circle(_Reference):
     """A horizontal circle about ``center`` (3,) [m] of ``radius`` [m], flown anticlockwise seen from above at
     ``frequency`` [Hz] (laps per second), from ``center + (radius, 0, 0)`` at ``t = 0``, facing ``yaw`` [rad]:
     ``x = c + r (cos 2πft, sin 2πft, 0)``."""
@@ -62,21 +103,14 @@ class Circle:
         self.radius = as_float("radius", radius, positive=True)
         self.frequency = as_float("frequency", frequency, nonnegative=True)
         self.yaw = as_float("yaw", yaw)
-
-    def __call__(self, t) -> dict:
-        w = 2.0 * math.pi * self.frequency
-        phase = w * _time(t)
-        c, s = math.cos(phase), math.sin(phase)
-        r = self.radius
-        return _flat_output((self.center + (r * c, r * s, 0.0), (-r * w * s, r * w * c, 0.0),
-                             (-r * w**2 * c, -r * w**2 * s, 0.0), (r * w**3 * s, -r * w**3 * c, 0.0),
-                             (r * w**4 * c, r * w**4 * s, 0.0)), self.yaw)  # fmt: skip
+        self.spec = _spec(CIRCLE, ((slice(0, 3), self.center), (3, self.radius), (4, self.frequency), (10, self.yaw)))
+        self._freeze()
 
     def __repr__(self) -> str:
         return f"Circle({self.center.tolist()}, radius={self.radius!r}, frequency={self.frequency!r})"
 
 
-class Lissajous:
+class Lissajous(_Reference):
     """A horizontal Lissajous figure about ``center``: ``x = c + (A sin(a t + δ), B sin(b t), 0)`` with ``A``, ``B``
     [m] and the angular frequencies ``a``, ``b`` [rad/s] (``A = 1, B = 0.5, a = 1, b = 2``: a figure eight, as
     RotorPy's), facing ``yaw`` [rad]."""
@@ -89,15 +123,9 @@ class Lissajous:
         self.delta = as_float("delta", delta)
         self.center = as_vector3("center", center)
         self.yaw = as_float("yaw", yaw)
-
-    def __call__(self, t) -> dict:
-        t = _time(t)
-        # The k-th derivative of A sin(a t + δ) is A a^k sin(a t + δ + k π/2).
-        derivatives = np.zeros((5, 3))
-        derivatives[:, 0] = self.A * self.a**_ORDERS * np.sin(self.a * t + self.delta + _ORDERS * (math.pi / 2))
-        derivatives[:, 1] = self.B * self.b**_ORDERS * np.sin(self.b * t + _ORDERS * (math.pi / 2))
-        derivatives[0] += self.center
-        return _flat_output(derivatives, self.yaw)
+        shape = (self.A, self.B, self.a, self.b, self.delta)
+        self.spec = _spec(LISSAJOUS, ((slice(0, 3), self.center), (slice(3, 8), shape), (10, self.yaw)))
+        self._freeze()
 
     def __repr__(self) -> str:
         return f"Lissajous(A={self.A!r}, B={self.B!r}, a={self.a!r}, b={self.b!r}, delta={self.delta!r})"
@@ -115,7 +143,7 @@ def _basis(derivative: int, s: float) -> np.ndarray:
     return row
 
 
-class MinimumSnap:
+class MinimumSnap(_Reference):
     """The path through ``waypoints`` (n, 3) [m] that minimises the integral of the squared snap, from rest to rest:
     one 7th-order polynomial per segment, passing each waypoint at its time, continuous up to the 6th derivative at
     each interior waypoint (the optimum's conditions; Mellinger & Kumar, ICRA 2011; Richter, Bry & Roy, ISRR 2013),
@@ -154,6 +182,9 @@ class MinimumSnap:
         self.waypoints, self.times = points, times
         self.yaw = as_float("yaw", yaw)
         self._coefficients = self._solve()  # (segments, 8, 3) in the normalised time s = (t - t_i) / T_i
+        ends = ((slice(0, 3), points[0]), (slice(3, 6), points[-1]), (10, self.yaw))
+        self.spec = _spec(MINIMUM_SNAP, ends, times, self._coefficients)
+        self._freeze()
 
     def _solve(self) -> np.ndarray:
         from scipy.linalg import LinAlgError, LinAlgWarning, solve
@@ -200,17 +231,6 @@ class MinimumSnap:
     def duration(self) -> float:
         """The time of the last waypoint [s]."""
         return float(self.times[-1])
-
-    def __call__(self, t) -> dict:
-        t = _time(t)
-        segment = int(np.clip(np.searchsorted(self.times, t, side="right") - 1, 0, len(self.times) - 2))
-        start, duration = self.times[segment], self.times[segment + 1] - self.times[segment]
-        if t < self.times[0] or t > self.times[-1]:
-            zero = np.zeros(3)
-            return _flat_output((self.waypoints[0 if t < self.times[0] else -1], zero, zero, zero, zero), self.yaw)
-        s = (t - start) / duration
-        coefficients = self._coefficients[segment]
-        return _flat_output([_basis(n, s) @ coefficients / duration**n for n in range(5)], self.yaw)
 
     def __repr__(self) -> str:
         return f"MinimumSnap({len(self.waypoints)} waypoints over {self.duration:g} s)"

@@ -633,7 +633,7 @@ class World:
             np.zeros_like(inputs.body_force), acts, state.body_pos, state.body_quat, state.body_linvel,
             state.body_angmom, scratch.backup, scratch.no_recording, recording, dt, n_steps,
             int(self._params.resolve_integrator(False)), record_every, origin_time, state.step_count - origin_step,
-            np.zeros((4, 3)), speeds,
+            np.zeros((5, 3)), speeds,
         )  # fmt: skip
         _advance_clock(state, dt, steps)
         if steps > 0:

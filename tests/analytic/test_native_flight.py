@@ -40,8 +40,7 @@ def test_the_compiled_flight_is_the_stepwise_flight(reference, gains, rate):
         world.simulate(0.5, 0.002)  # a second call carries the ticks and the integral on
         runs.append((recording, world, quad, handle))
     (a, wa, qa, ha), (b, wb, qb, hb) = runs
-    exact = type(reference) is not MinimumSnap  # its pieces are evaluated in another order: 1e-15 apart
-    tolerance = 0.0 if exact else 1e-12
+    tolerance = 0.0  # the same kernels in the same order
     np.testing.assert_allclose(a.position, b.position, rtol=0, atol=tolerance)
     np.testing.assert_allclose(wa.state.body_pos, wb.state.body_pos, rtol=0, atol=tolerance)
     np.testing.assert_allclose(qa.commanded_rotor_speeds, qb.commanded_rotor_speeds, rtol=1e-12)
@@ -49,6 +48,19 @@ def test_the_compiled_flight_is_the_stepwise_flight(reference, gains, rate):
     assert wa.time == wb.time and wa.step_count == wb.step_count
     np.testing.assert_allclose(qa._flight.controller._integral.value, qb._flight.controller._integral.value,
                                rtol=0, atol=tolerance)  # fmt: skip
+
+
+@pytest.mark.parametrize("dt", [0.01, 1 / 240, 0.001])
+def test_the_compiled_flight_is_the_stepwise_flight_at_every_step_size(dt):
+    """The controller at 100 Hz in worlds at 100, 240 (ticks fall between steps) and 1000 Hz."""
+    reference = MinimumSnap([(0, 0, 1), (1, 0, 1.5), (1, 1, 1), (0, 1, 1)], average_speed=0.8)
+    final = []
+    for stepwise in (False, True):
+        world, quad, handle = flight(reference, {"ki_pos": 1.0}, 100.0, stepwise)
+        world.simulate(reference.duration, dt)
+        final.append((world.state.body_pos.copy(), handle.calls))
+    np.testing.assert_array_equal(final[0][0], final[1][0])
+    assert final[0][1] == final[1][1]
 
 
 def test_the_compiled_flight_is_used_only_where_it_can_run():

@@ -12,7 +12,22 @@ import math
 from .._jit import inline, kernel
 from ..math3d import add, add_scaled, cross, dot, load3, mat_vec, quat_rotate_inv, quat_to_mat33, scale, sub
 
-__all__ = ["allocate_speeds", "attitude_error", "desired_axes", "se3_rotor_speeds"]
+__all__ = [
+    "HOVER",
+    "CIRCLE",
+    "LISSAJOUS",
+    "MINIMUM_SNAP",
+    "allocate_speeds",
+    "attitude_error",
+    "desired_axes",
+    "reference_derivatives",
+    "se3_rotor_speeds",
+]
+
+# The kinds of reference (tumble.references), and what their ``params`` (11,) hold: [0:3] the hover position, the
+# centre, or the first waypoint; circle: [3] radius, [4] frequency; Lissajous: [3:8] A, B, a, b, delta; minimum
+# snap: [3:6] the last waypoint; [10] the yaw.
+HOVER, CIRCLE, LISSAJOUS, MINIMUM_SNAP = 0, 1, 2, 3
 
 
 @inline
@@ -122,3 +137,48 @@ def se3_rotor_speeds(pos, vel, quat, angmom, inv_inertia, inertia, mass, gravity
 @inline
 def _vec4(a):
     return (a[0], a[1], a[2], a[3])
+
+
+@kernel
+def reference_derivatives(kind, params, knot_count, knots, coefficients, t, out):
+    """A reference's position, velocity, acceleration, jerk and snap at ``t`` into ``out`` (5, 3): the formulas of
+    ``tumble.references`` (one evaluation for the Python references and the compiled flights alike). MinimumSnap:
+    ``knots`` its times (the first ``knot_count``), ``coefficients`` its 7th-order pieces in the normalised time
+    ``s = (t - t_i) / T_i``; outside its times it waits at its first or last waypoint."""
+    out[:, :] = 0.0
+    if kind == HOVER:
+        out[0, :] = params[:3]
+    elif kind == CIRCLE:
+        r, w = params[3], 2.0 * math.pi * params[4]
+        c, s = math.cos(w * t), math.sin(w * t)
+        for k in range(5):  # d^k/dt^k of r (cos wt, sin wt) is r w^k (cos, sin)(wt + k π/2)
+            out[k, 0] = r * w**k * (c if k % 4 == 0 else -s if k % 4 == 1 else -c if k % 4 == 2 else s)
+            out[k, 1] = r * w**k * (s if k % 4 == 0 else c if k % 4 == 1 else -s if k % 4 == 2 else -c)
+        out[0, :] += params[:3]
+    elif kind == LISSAJOUS:
+        A, B, a, b, delta = params[3], params[4], params[5], params[6], params[7]
+        for k in range(5):  # the k-th derivative of A sin(a t + δ) is A a^k sin(a t + δ + k π/2)
+            out[k, 0] = A * a**k * math.sin(a * t + delta + k * (math.pi / 2))
+            out[k, 1] = B * b**k * math.sin(b * t + k * (math.pi / 2))
+        out[0, :] += params[:3]
+    else:
+        last = knot_count - 1
+        if t < knots[0]:
+            out[0, :] = params[:3]
+        elif t > knots[last]:
+            out[0, :] = params[3:6]
+        else:
+            piece = 0
+            while piece < last - 1 and knots[piece + 1] <= t:
+                piece += 1
+            duration = knots[piece + 1] - knots[piece]
+            s = (t - knots[piece]) / duration
+            for derivative in range(5):
+                for axis in range(3):
+                    value = 0.0
+                    for k in range(derivative, 8):
+                        factor = 1.0  # k! / (k - derivative)!
+                        for m in range(k - derivative + 1, k + 1):
+                            factor *= m
+                        value += factor * s ** (k - derivative) * coefficients[piece, k, axis]
+                    out[derivative, axis] = value / duration**derivative

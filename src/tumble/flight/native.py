@@ -2,10 +2,10 @@
 ``quad.fly(SE3Controller(...), Hover | Circle | Lissajous | MinimumSnap)`` runs all its steps in one kernel call,
 the controllers at their ticks between the steps, instead of one Python round trip per step.
 
-It does what the step-by-step path does, in the same order: at each step's counted start time ``t0 + s h`` the
-flights that are due evaluate their reference and the SE(3) law (the same kernel) and command their rotors; every
-body takes one step of the same integrator (``_advance_body`` with one step); the motors advance by ``h``. The two
-paths agree to round-off (the references' sines are the only difference: ``math`` here, NumPy there).
+It does what the step-by-step path does, in the same order and with the same kernels: at each step's counted start
+time the flights that are due evaluate their reference (``reference_derivatives``) and the SE(3) law
+(``se3_rotor_speeds``) and command their rotors; every body takes one step of the same integrator (``_advance_body``
+with one step); the motors advance by ``h``. The two paths fly bit for bit alike.
 """
 
 from __future__ import annotations
@@ -21,11 +21,10 @@ from ..dynamics.integrate import _advance_body
 from ..math3d import store3, store4
 from ..references import Circle, Hover, Lissajous, MinimumSnap
 from . import SE3Controller
-from .kernels import se3_rotor_speeds
+from .kernels import reference_derivatives, se3_rotor_speeds
 
 __all__ = ["FlightTable", "flight_table", "fly_steps"]
 
-_HOVER, _CIRCLE, _LISSAJOUS, _MINIMUM_SNAP = 0, 1, 2, 3
 _TICK_TOLERANCE = 1e-9  # as tumble.control's: a tick within a billionth of a step counts as reached
 
 
@@ -50,37 +49,15 @@ class FlightTable(NamedTuple):
     k_thrust: np.ndarray  # (f,)
     squared_limits: np.ndarray  # (f, 2)
     kind: np.ndarray  # (f,) int64: _HOVER, _CIRCLE, _LISSAJOUS, _MINIMUM_SNAP
-    params: np.ndarray  # (f, 11): see _reference_row
+    params: np.ndarray  # (f, 11): see flight.kernels (HOVER and the others)
     knot_count: np.ndarray  # (f,) int64: MinimumSnap's waypoints
     knots: np.ndarray  # (f, k): MinimumSnap's times, padded
     coefficients: np.ndarray  # (f, k - 1, 8, 3): MinimumSnap's pieces, padded
 
 
-def _reference_row(trajectory) -> tuple[int, np.ndarray, np.ndarray, np.ndarray] | None:
-    """``(kind, params (11,), knots, coefficients)`` of a trajectory the kernel evaluates; None for others.
-
-    ``params``: [0:3] the position (hover) or centre, then circle: radius, frequency; Lissajous: A, B, a, b, delta;
-    [10] the yaw. ``knots`` and ``coefficients``: MinimumSnap's times and pieces."""
-    params = np.zeros(11)
-    knots, coefficients = np.array([0.0]), np.zeros((0, 8, 3))
-    kind = type(trajectory)
-    if kind is Hover:
-        params[:3] = trajectory.position
-        code = _HOVER
-    elif kind is Circle:
-        params[:5] = (*trajectory.center, trajectory.radius, trajectory.frequency)
-        code = _CIRCLE
-    elif kind is Lissajous:
-        t = trajectory
-        params[:8] = (*t.center, t.A, t.B, t.a, t.b, t.delta)
-        code = _LISSAJOUS
-    elif kind is MinimumSnap:
-        knots, coefficients = trajectory.times, trajectory._coefficients
-        code = _MINIMUM_SNAP
-    else:
-        return None
-    params[10] = trajectory.yaw
-    return code, params, knots, coefficients
+def _reference_spec(trajectory):
+    """The :class:`~tumble.references.ReferenceSpec` of a trajectory the kernel evaluates; None for others."""
+    return trajectory.spec if type(trajectory) in (Hover, Circle, Lissajous, MinimumSnap) else None
 
 
 def flight_table(world, controllers) -> FlightTable | None:
@@ -91,7 +68,7 @@ def flight_table(world, controllers) -> FlightTable | None:
         flight = getattr(controller, "_flight", None)
         if flight is None or type(flight.controller) is not SE3Controller:
             return None
-        reference = _reference_row(flight.trajectory)
+        reference = _reference_spec(flight.trajectory)
         if reference is None:
             return None
         quad, law = flight.quad, flight.controller
@@ -101,7 +78,7 @@ def flight_table(world, controllers) -> FlightTable | None:
         rows.append((quad, law, controller, reference))
     if not rows:
         return None
-    size = max(len(r[3][2]) for r in rows)
+    size = max(r[3].knots.shape[0] for r in rows)
     table = FlightTable(
         body=np.array([q.body.index for q, *_ in rows], np.int64),
         rows=np.array([[rotor._row for rotor in q.rotors] for q, *_ in rows], np.int64),
@@ -128,62 +105,15 @@ def flight_table(world, controllers) -> FlightTable | None:
         mixer_inverse=np.array([q.mixer.inverse for q, *_ in rows], float),
         k_thrust=np.array([q.params["k_thrust"] for q, *_ in rows], float),
         squared_limits=np.array([q.mixer.squared_limits for q, *_ in rows], float),
-        kind=np.array([r[3][0] for r in rows], np.int64),
-        params=np.array([r[3][1] for r in rows], float),
-        knot_count=np.array([len(r[3][2]) for r in rows], np.int64),
-        knots=np.array([np.pad(r[3][2], (0, size - len(r[3][2]))) for r in rows], float),
+        kind=np.array([r[3].kind for r in rows], np.int64),
+        params=np.array([r[3].params for r in rows], float),
+        knot_count=np.array([r[3].knot_count for r in rows], np.int64),
+        knots=np.array([np.pad(r[3].knots, (0, size - len(r[3].knots))) for r in rows], float),
         coefficients=np.array(
-            [np.pad(r[3][3], ((0, max(size - 1, 1) - len(r[3][3])), (0, 0), (0, 0))) for r in rows], float
+            [np.pad(r[3].coefficients, ((0, size - len(r[3].coefficients)), (0, 0), (0, 0))) for r in rows], float
         ),  # fmt: skip
     )
     return table
-
-
-@kernel
-def _reference(kind, params, knot_count, knots, coefficients, t, out):
-    """The reference's position, velocity, acceleration and jerk at ``t`` into ``out`` (4, 3) (tumble.references'
-    formulas)."""
-    out[:, :] = 0.0
-    if kind == _HOVER:
-        out[0, :] = params[:3]
-    elif kind == _CIRCLE:
-        r, w = params[3], 2.0 * math.pi * params[4]
-        phase = w * t
-        c, s = math.cos(phase), math.sin(phase)
-        out[0, 0], out[0, 1], out[0, 2] = params[0] + r * c, params[1] + r * s, params[2]
-        out[1, 0], out[1, 1] = -r * w * s, r * w * c
-        out[2, 0], out[2, 1] = -r * w**2 * c, -r * w**2 * s
-        out[3, 0], out[3, 1] = r * w**3 * s, -r * w**3 * c
-    elif kind == _LISSAJOUS:
-        A, B, a, b, delta = params[3], params[4], params[5], params[6], params[7]
-        for k in range(4):
-            out[k, 0] = A * a**k * math.sin(a * t + delta + k * (math.pi / 2))
-            out[k, 1] = B * b**k * math.sin(b * t + k * (math.pi / 2))
-        out[0, :] += params[:3]
-    else:
-        last = knot_count - 1
-        if t < knots[0] or t > knots[last]:  # waiting at an end
-            piece, s = (0, 0.0) if t < knots[0] else (last - 1, 1.0)
-            for axis in range(3):
-                value = 0.0
-                for k in range(8):
-                    value += coefficients[piece, k, axis] * s**k
-                out[0, axis] = value
-            return
-        piece = 0
-        while piece < last - 1 and knots[piece + 1] <= t:
-            piece += 1
-        duration = knots[piece + 1] - knots[piece]
-        s = (t - knots[piece]) / duration
-        for derivative in range(4):
-            for axis in range(3):
-                value = 0.0
-                for k in range(derivative, 8):
-                    factor = 1.0
-                    for m in range(k - derivative + 1, k + 1):
-                        factor *= m
-                    value += factor * s ** (k - derivative) * coefficients[piece, k, axis]
-                out[derivative, axis] = value / duration**derivative
 
 
 @kernel
@@ -191,20 +121,22 @@ def fly_steps(table, bodies, gravity, force, torque, zero, acts, pos, quat, linv
               h, n_steps, method, record_every, origin_time, origin_count, ref, speeds):  # fmt: skip
     """``n_steps`` steps of ``h``: before each, the flights that are due command their rotors; then every body one
     step, the motors ``h`` on, the frame recorded. The step ``s`` starts at ``origin_time + (origin_count + s) h``,
-    as ``tumble.control.StepClock`` counts. Returns ``(steps_done, failing_body, failing_flight)`` (-1: none); on a
-    failure the bodies are as before that step, and ``speeds`` holds what a failing flight asked for."""
+    as ``tumble.control.StepClock`` counts; ``ref`` (5, 3) and ``speeds`` (4,) are scratch. Returns ``(steps_done,
+    failing_body, failing_flight)`` (-1: none); on a failure the bodies are as before that step, and ``speeds``
+    holds what a failing flight asked for."""
     flights = table.body.shape[0]
+    integral = np.zeros(3)  # the integral term of the flight being evaluated
     for s in range(n_steps):
         t = origin_time + (origin_count + s) * h
         for f in range(flights):
             rate = table.rate[f]
             if rate > 0.0 and t < table.next_tick[f] / rate - _TICK_TOLERANCE * h:
                 continue
-            _reference(table.kind[f], table.params[f], table.knot_count[f], table.knots[f], table.coefficients[f], t,
-                       ref)  # fmt: skip
+            reference_derivatives(table.kind[f], table.params[f], table.knot_count[f], table.knots[f],
+                                  table.coefficients[f], t, ref)  # fmt: skip
             b = table.body[f]
             gains = table.gains[f]
-            integral = np.zeros(3)
+            integral[:] = 0.0
             if gains[6] > 0.0 or gains[7] > 0.0 or gains[8] > 0.0:  # tumble.flight._Integral
                 last = table.last_time[f]
                 if not math.isnan(last) and t > last:
