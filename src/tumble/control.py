@@ -91,6 +91,16 @@ class StepClock:
         return counted
 
 
+def controller_failed(name: str, error: Exception, t: float, step: int) -> SimulationError:
+    """The error that stops a run when the controller ``name`` raised ``error`` before ``step``, at ``t``."""
+    return SimulationError(
+        f"controller {name!r} raised {type(error).__name__}: {error} at t = {t:.6g} s (before step {step}); the world "
+        "keeps its state from before that step",
+        step=step,
+        controller=name,
+    )
+
+
 class Controllers:
     """A world's controllers, in the order added."""
 
@@ -136,11 +146,6 @@ class Controllers:
             try:
                 controller.callback(world, t)
             except Exception as error:
-                raise SimulationError(
-                    f"controller {controller.name!r} raised {type(error).__name__}: {error} at t = {t:.6g} s "
-                    f"(before step {state.step_count}); the world keeps its state from before that step",
-                    step=state.step_count,
-                    controller=controller.name,
-                ) from error
+                raise controller_failed(controller.name, error, t, state.step_count) from error
             controller.calls += 1
             controller._advance(t, dt)

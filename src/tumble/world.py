@@ -16,8 +16,9 @@ from . import diagnostics
 from ._validate import as_float, as_quaternion, as_vector3, mass_or_density
 from .actuators import Actuation, Actuator
 from .builder import ModelBuilder, ShapeSpec
-from .control import Controller, Controllers, StepClock
+from .control import Controller, Controllers, StepClock, controller_failed
 from .errors import SimulationError
+from .flight import bad_rotor_speeds
 from .handles import Body, Joint
 from .inputs import Inputs
 from .mass import MassProperties
@@ -647,15 +648,9 @@ class World:
             integral._last_time = None if np.isnan(table.last_time[k]) else float(table.last_time[k])
         error = None
         if flight >= 0:
-            name, t = controllers[flight].name, self._next_step_time(dt)
-            law = type(controllers[flight]._flight.controller).__name__
-            error = SimulationError(
-                f"controller {name!r} raised ValueError: {law}.update returned {speeds.tolist()!r} at t = {t:.6g} s, "
-                f"not four finite rotor speeds at t = {t:.6g} s (before step {state.step_count}); the world keeps "
-                "its state from before that step",
-                step=state.step_count,
-                controller=name,
-            )  # fmt: skip
+            handle, t = controllers[flight], self._next_step_time(dt)
+            error = controller_failed(handle.name, bad_rotor_speeds(handle._flight.controller, speeds, t), t,
+                                      state.step_count)  # fmt: skip
         return steps, failing, error
 
     def _simulate_stepwise(self, dt: float, n_steps: int, recording, record_every: int):

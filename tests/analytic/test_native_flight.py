@@ -88,3 +88,19 @@ def test_a_body_that_fails_mid_run_stops_the_compiled_flight_as_the_stepwise_one
         outcomes.append((world.step_count, world.state.body_pos.copy()))
     assert outcomes[0][0] == outcomes[1][0]
     np.testing.assert_array_equal(outcomes[0][1], outcomes[1][1])
+
+
+def test_a_flight_that_asks_for_nan_stops_both_paths_alike():
+    """A gain set to NaN behind the controller's back: both paths stop before the first step with the same error,
+    naming the controller and the time."""
+    messages = []
+    for stepwise in (False, True):
+        world, quad, handle = flight(Hover((0.0, 0.0, 1.0)), {}, None, stepwise)
+        world.simulate(0.1, 0.01)
+        quad._flight.controller.kp_att = float("nan")
+        with pytest.raises(tumble.SimulationError, match=r"controller 'SE3Controller on Hover' raised ValueError: "
+                           r"SE3Controller.update returned \[nan.*at t = 0.1 s") as error:  # fmt: skip
+            world.simulate(0.1, 0.01)
+        assert error.value.controller == "SE3Controller on Hover" and world.step_count == 10
+        messages.append(str(error.value))
+    assert messages[0] == messages[1]

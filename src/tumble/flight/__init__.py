@@ -301,6 +301,12 @@ class CascadedPID:
         return self._loops._acceleration_to_speeds(acceleration, yaw, yaw_rate)
 
 
+def bad_rotor_speeds(controller, speeds: np.ndarray, t: float) -> ValueError:
+    """What a flight's controller returned that cannot be commanded."""
+    return ValueError(f"{type(controller).__name__}.update returned {speeds.tolist()!r} at t = {t:.6g} s, not four "
+                      "finite rotor speeds")  # fmt: skip
+
+
 class Flight(NamedTuple):
     """What :func:`fly` attached to a vehicle: the controller, the trajectory, the rate and the world controller."""
 
@@ -323,8 +329,7 @@ def fly(quad, controller, trajectory, rate: float | None = None):
     def follow(world, t):
         speeds = np.asarray(controller.update(t, trajectory(t)), dtype=float)
         if speeds.shape != (4,) or not np.all(np.isfinite(speeds)):
-            raise ValueError(f"{type(controller).__name__}.update returned {speeds.tolist()!r} at t = {t:.6g} s, "
-                             f"not four finite rotor speeds")  # fmt: skip
+            raise bad_rotor_speeds(controller, speeds, t)
         quad.command_rotor_speeds(speeds)
 
     handle = quad.world.add_controller(follow, rate=rate, name=name)
