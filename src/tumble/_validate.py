@@ -127,6 +127,17 @@ def as_body(value):
     return value
 
 
+def as_new_part(world, part, kind: type, name: str, article: str, described: str):
+    """``part`` (an actuator, a sensor), a ``kind``, in no world yet, on a dynamic body of ``world``; ``name`` and
+    its ``article`` name it in messages, ``described`` says what it must be."""
+    if not isinstance(part, kind):
+        raise TypeError(f"{name} must be {described}, got {part!r}")
+    if part._world is not None:
+        raise ValueError(f"{part!r} is in a world already")
+    as_dynamic_body_of(world, part.body, f"{article} {name}")
+    return part
+
+
 def as_dynamic_body_of(world, value, what: str):
     """A body of ``world`` that moves, for ``what`` (an actuator, a sensor, drag) to act on or read."""
     body = as_body(value)

@@ -20,7 +20,7 @@ import math
 
 import numpy as np
 
-from ._validate import as_body, as_dynamic_body_of, as_float, as_unit_vector3, as_vector3
+from ._validate import as_body, as_dynamic_body_of, as_float, as_new_part, as_unit_vector3, as_vector3
 from .dynamics.actuation import ROTOR, THRUSTER, ActuatorArrays
 
 __all__ = ["Actuator", "Rotor", "Thruster", "command_all"]
@@ -184,11 +184,7 @@ class Actuation:
         self._body_com = np.zeros((0, 3))
 
     def add(self, world, actuator) -> Actuator:
-        if not isinstance(actuator, Actuator):
-            raise TypeError(f"actuator must be a tumble.actuators.Rotor or Thruster, got {actuator!r}")
-        if actuator._world is not None:
-            raise ValueError(f"{actuator!r} is in a world already")
-        as_dynamic_body_of(world, actuator.body, "an actuator")
+        as_new_part(world, actuator, Actuator, "actuator", "an", "a tumble.actuators.Rotor or Thruster")
         self._pack_current()
         actuator._world = world
         self.actuators.append(actuator)

@@ -24,7 +24,7 @@ from __future__ import annotations
 import numpy as np
 
 from . import diagnostics
-from ._validate import as_body, as_dynamic_body_of, as_float, as_seed, as_vector3
+from ._validate import as_body, as_float, as_new_part, as_seed, as_vector3
 from .rotation import quat_from_rotvec, quat_multiply, quat_to_matrix
 
 __all__ = ["IMU", "Pose", "Sensor", "Sensors"]
@@ -123,11 +123,7 @@ class Sensors:
         return iter([*self.imus, *self.poses])
 
     def add(self, world, sensor) -> Sensor:
-        if not isinstance(sensor, Sensor):
-            raise TypeError(f"sensor must be a tumble.sensors.IMU or Pose, got {sensor!r}")
-        if sensor._world is not None:
-            raise ValueError(f"{sensor!r} is in a world already")
-        as_dynamic_body_of(world, sensor.body, "a sensor")
+        as_new_part(world, sensor, Sensor, "sensor", "a", "a tumble.sensors.IMU or Pose")
         sensor._world = world
         (self.imus if isinstance(sensor, IMU) else self.poses).append(sensor)
         self._imu_bodies = self._imu_positions = self._pose_bodies = None
