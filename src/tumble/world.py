@@ -526,13 +526,17 @@ class World:
         if failing >= 0:
             raise self._simulation_error(failing)
 
-    def _controlled_step(self, dt: float) -> int:
-        """The controllers that are due, one step, the sensors' samples: the failing body's row, or -1.
+    def _controlled_step(self, dt: float, flights=None) -> int:
+        """The controllers that are due (or the compiled ``flights`` in their place), one step, the sensors'
+        samples: the failing body's row, or -1.
 
         Raises:
             SimulationError: a controller raised (before the step: the world is as it was).
         """
-        self._controllers.run(self, self._next_step_time(dt), dt)
+        if flights is None:
+            self._controllers.run(self, self._next_step_time(dt), dt)
+        else:
+            self._run_flights(flights, self._next_step_time(dt), dt)
         self._sync()
         self._sensors.before_step(self)
         _, failing = simulate_steps(self._model, self._state, self._inputs, self._params, self._scratch, dt,
@@ -606,21 +610,54 @@ class World:
         return trajectory
 
     def _native_flights(self):
-        """The table of the world's controllers when every one is a flight the compiled loop runs itself
-        (``tumble.flight.native``: SE(3) on a known reference) and nothing else needs Python between the steps
-        (no sensors, a constant wind, no contacts or joints); else None."""
-        if not self._controllers or self._sensors or not isinstance(self._wind, (Constant, type(None))):
-            return None
-        if self.model.has_constraints:
+        """The table of the world's controllers when every one is a flight the kernels run themselves
+        (``tumble.flight.native``: SE(3) on a known reference); else None."""
+        if not self._controllers:
             return None
         from .flight.native import flight_table
 
+        self._sync()
         self._actuation.for_bodies(self._model.body_com_local)  # the rotors' rows in the arrays
         return flight_table(self, list(self._controllers))
 
     def _simulate_flights(self, table, dt: float, n_steps: int, recording, record_every: int):
-        """All the steps in one compiled call with the flights of ``table`` between them: ``(steps_done,
-        failing_body, error)`` as :meth:`_simulate_stepwise`."""
+        """The steps with the flights of ``table`` between them, compiled: ``(steps_done, failing_body, error)`` as
+        :meth:`_simulate_stepwise`. Free bodies (no sensors, a constant wind) take all the steps in one call; else
+        each step is a call, and the flights one more (instead of a Python controller each)."""
+        if self._model.has_constraints or self._sensors or not isinstance(self._wind, (Constant, type(None))):
+            result = self._simulate_stepwise(dt, n_steps, recording, record_every, flights=table)
+        else:
+            result = self._fly_free_bodies(table, dt, n_steps, recording, record_every)
+        for k, controller in enumerate(self._controllers):
+            controller.calls += int(table.calls[k])
+            controller._next_tick = int(table.next_tick[k])
+            integral = controller._flight.controller._integral
+            integral.value[:] = table.integral[k]
+            integral._last_time = None if np.isnan(table.last_time[k]) else float(table.last_time[k])
+        return result
+
+    def _run_flights(self, table, t: float, dt: float) -> None:
+        """The flights of ``table`` that are due before the step of ``dt`` from ``t`` (``flight.native``).
+
+        Raises:
+            SimulationError: a flight asked for rotor speeds that are not finite (the world is as it was).
+        """
+        from .flight.native import command_flights
+
+        state, speeds = self._state, np.zeros(4)
+        failing = command_flights(table, self._model.gravity, self._actuation.arrays, state.body_pos, state.body_quat,
+                                  state.body_linvel, state.body_angmom, t, dt, np.zeros((5, 3)), speeds,
+                                  np.zeros(3))  # fmt: skip
+        if failing >= 0:
+            raise self._flight_failed(table, failing, speeds, t)
+
+    def _flight_failed(self, table, flight: int, speeds: np.ndarray, t: float) -> SimulationError:
+        handle = list(self._controllers)[flight]
+        error = bad_rotor_speeds(handle._flight.controller, speeds, t)
+        return controller_failed(handle.name, error, t, self._state.step_count)
+
+    def _fly_free_bodies(self, table, dt: float, n_steps: int, recording, record_every: int):
+        """Free bodies only: every step and flight in one compiled call (``flight.native.fly_steps``)."""
         from .flight.native import fly_steps
         from .pipeline import _advance_clock
 
@@ -639,26 +676,15 @@ class World:
         _advance_clock(state, dt, steps)
         if steps > 0:
             inputs.clear()
-        controllers = list(self._controllers)
-        for k, controller in enumerate(controllers):
-            controller.calls += int(table.calls[k])
-            controller._next_tick = int(table.next_tick[k])
-            integral = controller._flight.controller._integral
-            integral.value[:] = table.integral[k]
-            integral._last_time = None if np.isnan(table.last_time[k]) else float(table.last_time[k])
-        error = None
-        if flight >= 0:
-            handle, t = controllers[flight], self._next_step_time(dt)
-            error = controller_failed(handle.name, bad_rotor_speeds(handle._flight.controller, speeds, t), t,
-                                      state.step_count)  # fmt: skip
+        error = self._flight_failed(table, flight, speeds, self._next_step_time(dt)) if flight >= 0 else None
         return steps, failing, error
 
-    def _simulate_stepwise(self, dt: float, n_steps: int, recording, record_every: int):
-        """Step by step from Python, the controllers before each step and the sensors after it: ``(steps_done,
-        failing_body, error)``."""
+    def _simulate_stepwise(self, dt: float, n_steps: int, recording, record_every: int, flights=None):
+        """Step by step from Python, the controllers (or the compiled ``flights``) before each step and the sensors
+        after it: ``(steps_done, failing_body, error)``."""
         for step in range(n_steps):
             try:
-                failing = self._controlled_step(dt)
+                failing = self._controlled_step(dt, flights)
             except SimulationError as error:
                 return step, -1, error
             if self._state.body_count != recording.pos.shape[1]:

@@ -63,13 +63,34 @@ def test_the_compiled_flight_is_the_stepwise_flight_at_every_step_size(dt):
     assert final[0][1] == final[1][1]
 
 
-def test_the_compiled_flight_is_used_only_where_it_can_run():
+def test_the_compiled_flights_are_used_only_when_every_controller_is_one():
     world, quad, _ = flight(Hover((0.0, 0.0, 1.0)), {}, None, stepwise=False)
     assert world._native_flights() is not None
-    world.add_static(tumble.Plane())  # contacts: the step-by-step path
-    assert world._native_flights() is None
+    world.add_static(tumble.Plane())  # contacts: a step per call, the flights compiled between them
+    assert world._native_flights() is not None
     world, quad, _ = flight(Hover((0.0, 0.0, 1.0)), {}, None, stepwise=True)
     assert world._native_flights() is None
+
+
+@pytest.mark.parametrize("dt", [0.01, 1 / 240])
+def test_with_contacts_the_compiled_flights_fly_as_python_controllers(dt):
+    """Two vehicles over a ground (so contacts and a step per call), one landing on it: the flights compiled
+    between the steps and the Python controllers give the same run, bit for bit."""
+    runs = []
+    for stepwise in (False, True):
+        world = tumble.World()
+        world.add_static(tumble.Plane())
+        landing = MinimumSnap([(3.0, 0.0, 1.0), (3.0, 0.0, 0.0)], [0.0, 3.0])
+        for reference in (Circle((0.0, 0.0, 1.0), 1.0, 0.2), landing):
+            quad = Quadrotor(world, position=reference(0.0)["position"])
+            quad.rotor_speeds = [quad.hover_rotor_speed] * 4
+            quad.fly(SE3Controller(quad, ki_pos=1.0), reference, rate=100.0)
+        if stepwise:
+            world.add_controller(lambda world, t: None, name="idle")
+        recording = world.simulate(4.0, dt, record_every=4)
+        runs.append((recording.position, [c.calls for c in world.controllers][:2], len(world.contacts().body_a)))
+    np.testing.assert_array_equal(runs[0][0], runs[1][0])
+    assert runs[0][1] == runs[1][1] and runs[0][2] == runs[1][2] >= 4
 
 
 def test_a_body_that_fails_mid_run_stops_the_compiled_flight_as_the_stepwise_one_does():

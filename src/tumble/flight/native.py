@@ -23,7 +23,7 @@ from ..references import Circle, Hover, Lissajous, MinimumSnap
 from . import SE3Controller
 from .kernels import reference_derivatives, se3_rotor_speeds
 
-__all__ = ["FlightTable", "flight_table", "fly_steps"]
+__all__ = ["FlightTable", "command_flights", "flight_table", "fly_steps"]
 
 _TICK_TOLERANCE = 1e-9  # as tumble.control's: a tick within a billionth of a step counts as reached
 
@@ -117,50 +117,60 @@ def flight_table(world, controllers) -> FlightTable | None:
 
 
 @kernel
+def command_flights(table, gravity, acts, pos, quat, linvel, angmom, t, h, ref, speeds, integral):
+    """Before the step of ``h`` that starts at ``t``: each flight that is due evaluates its reference and the SE(3)
+    law and commands its rotors (``tumble.flight.fly`` and ``_Integral``, in the order of the table). Returns the
+    first flight whose rotor speeds are not finite (then in ``speeds``), or -1. ``ref`` (5, 3), ``speeds`` (4,) and
+    ``integral`` (3,) are scratch."""
+    for f in range(table.body.shape[0]):
+        rate = table.rate[f]
+        if rate > 0.0 and t < table.next_tick[f] / rate - _TICK_TOLERANCE * h:
+            continue
+        reference_derivatives(table.kind[f], table.params[f], table.knot_count[f], table.knots[f],
+                              table.coefficients[f], t, ref)  # fmt: skip
+        b = table.body[f]
+        gains = table.gains[f]
+        integral[:] = 0.0
+        if gains[6] > 0.0 or gains[7] > 0.0 or gains[8] > 0.0:
+            last = table.last_time[f]
+            if not math.isnan(last) and t > last:
+                for k in range(3):
+                    value = table.integral[f, k] + (pos[b, k] - ref[0, k]) * (t - last)
+                    if gains[6 + k] > 0.0:
+                        bound = gains[11] / gains[6 + k]
+                        value = min(max(value, -bound), bound)
+                    table.integral[f, k] = value
+            table.last_time[f] = t
+            for k in range(3):
+                integral[k] = gains[6 + k] * table.integral[f, k]
+        se3_rotor_speeds(pos[b], linvel[b], quat[b], angmom[b], table.inv_inertia[f], table.inertia[f], table.mass[f],
+                         gravity, ref, table.params[f, 10], 0.0, gains[0:3], gains[3:6], integral, gains[9],
+                         gains[10], table.feedforward[f], table.mixer_inverse[f], table.k_thrust[f],
+                         table.squared_limits[f, 0], table.squared_limits[f, 1], speeds)  # fmt: skip
+        for k in range(4):
+            if not math.isfinite(speeds[k]):
+                return f
+        for k in range(4):
+            acts.command[table.rows[f, k]] = min(max(speeds[k], table.speed_min[f, k]), table.speed_max[f, k])
+        table.calls[f] += 1
+        if rate > 0.0:
+            table.next_tick[f] = max(table.next_tick[f] + 1, math.floor((t + _TICK_TOLERANCE * h) * rate) + 1)
+    return -1
+
+
+@kernel
 def fly_steps(table, bodies, gravity, force, torque, zero, acts, pos, quat, linvel, angmom, backup, no_recording, rec,
               h, n_steps, method, record_every, origin_time, origin_count, ref, speeds):  # fmt: skip
-    """``n_steps`` steps of ``h``: before each, the flights that are due command their rotors; then every body one
-    step, the motors ``h`` on, the frame recorded. The step ``s`` starts at ``origin_time + (origin_count + s) h``,
-    as ``tumble.control.StepClock`` counts; ``ref`` (5, 3) and ``speeds`` (4,) are scratch. Returns ``(steps_done,
-    failing_body, failing_flight)`` (-1: none); on a failure the bodies are as before that step, and ``speeds``
-    holds what a failing flight asked for."""
-    flights = table.body.shape[0]
-    integral = np.zeros(3)  # the integral term of the flight being evaluated
+    """``n_steps`` steps of ``h`` of a world of free bodies: before each, :func:`command_flights`; then every body
+    one step, the motors ``h`` on, the frame recorded. The step ``s`` starts at ``origin_time + (origin_count + s)
+    h``, as ``tumble.control.StepClock`` counts. Returns ``(steps_done, failing_body, failing_flight)`` (-1: none);
+    on a failure the bodies are as before that step, and ``speeds`` holds what a failing flight asked for."""
+    integral = np.zeros(3)
     for s in range(n_steps):
-        t = origin_time + (origin_count + s) * h
-        for f in range(flights):
-            rate = table.rate[f]
-            if rate > 0.0 and t < table.next_tick[f] / rate - _TICK_TOLERANCE * h:
-                continue
-            reference_derivatives(table.kind[f], table.params[f], table.knot_count[f], table.knots[f],
-                                  table.coefficients[f], t, ref)  # fmt: skip
-            b = table.body[f]
-            gains = table.gains[f]
-            integral[:] = 0.0
-            if gains[6] > 0.0 or gains[7] > 0.0 or gains[8] > 0.0:  # tumble.flight._Integral
-                last = table.last_time[f]
-                if not math.isnan(last) and t > last:
-                    for k in range(3):
-                        value = table.integral[f, k] + (pos[b, k] - ref[0, k]) * (t - last)
-                        if gains[6 + k] > 0.0:
-                            bound = gains[11] / gains[6 + k]
-                            value = min(max(value, -bound), bound)
-                        table.integral[f, k] = value
-                table.last_time[f] = t
-                for k in range(3):
-                    integral[k] = gains[6 + k] * table.integral[f, k]
-            se3_rotor_speeds(pos[b], linvel[b], quat[b], angmom[b], table.inv_inertia[f], table.inertia[f],
-                             table.mass[f], gravity, ref, table.params[f, 10], 0.0, gains[0:3], gains[3:6], integral,
-                             gains[9], gains[10], table.feedforward[f], table.mixer_inverse[f], table.k_thrust[f],
-                             table.squared_limits[f, 0], table.squared_limits[f, 1], speeds)  # fmt: skip
-            for k in range(4):
-                if not math.isfinite(speeds[k]):
-                    return s, -1, f
-            for k in range(4):
-                acts.command[table.rows[f, k]] = min(max(speeds[k], table.speed_min[f, k]), table.speed_max[f, k])
-            table.calls[f] += 1
-            if rate > 0.0:
-                table.next_tick[f] = max(table.next_tick[f] + 1, math.floor((t + _TICK_TOLERANCE * h) * rate) + 1)
+        failing = command_flights(table, gravity, acts, pos, quat, linvel, angmom, origin_time + (origin_count + s) * h,
+                                  h, ref, speeds, integral)  # fmt: skip
+        if failing >= 0:
+            return s, -1, failing
         body_count = pos.shape[0]
         for i in range(body_count):
             store3(backup[0], i, (pos[i, 0], pos[i, 1], pos[i, 2]))
