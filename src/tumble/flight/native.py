@@ -1,6 +1,7 @@
-"""Flights inside the compiled loop: ``world.simulate`` of free-flying vehicles whose only controllers are
-``quad.fly(SE3Controller(...), Hover | Circle | Lissajous | MinimumSnap)`` runs all its steps in one kernel call,
-the controllers at their ticks between the steps, instead of one Python round trip per step.
+"""Flights in the kernels: when a world's only controllers are ``quad.fly(SE3Controller(...), Hover | Circle |
+Lissajous | MinimumSnap)``, ``world.simulate`` evaluates them with :func:`command_flights`, one kernel call for all
+of them, instead of a Python controller each; a world of free bodies (no contacts or joints, no sensors, a constant
+wind) takes every step and flight in one call (:func:`fly_steps`).
 
 It does what the step-by-step path does, in the same order and with the same kernels: at each step's counted start
 time the flights that are due evaluate their reference (``reference_derivatives``) and the SE(3) law
