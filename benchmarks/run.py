@@ -19,6 +19,8 @@ Run from the repository root:
                  tumble against PyBullet and MuJoCo (``benchmarks/joints.py``).
 ``quadrotor``    a Crazyflie flying the figure eight at 100 and 500 Hz with the SE(3) controller every step,
                  tumble against RotorPy (``benchmarks/quadrotor.py``).
+``build``        building worlds of 1k to 100k free bodies and 1k to 10k joints (a chain, a grid) through the API
+                 and from scene files, beside MuJoCo compiling the same bodies from MJCF (``benchmarks/build.py``).
 
 Every timing is the best of ``--repeat`` runs after a first call that is reported apart (it includes the
 JIT compile or the load from Numba's disk cache). Both engines run in the same process, so compare the
@@ -48,7 +50,7 @@ import numpy as np
 
 import tumble
 
-from . import articulation, contact, joints, peers, quadrotor
+from . import articulation, build, contact, joints, peers, quadrotor
 
 __all__ = [
     "BENCHMARKS",
@@ -99,6 +101,8 @@ class Sizes:
     chain_seconds: float = 10.0
     quadrotor_seconds: float = 10.0  # simulated time of each quadrotor flight (benchmarks/quadrotor.py)
     rotorpy_seconds: float = 10.0  # at most this much for RotorPy's own flights
+    build_bodies: tuple[int, ...] = (1_000, 10_000, 100_000)  # worlds built (benchmarks/build.py)
+    build_joints: tuple[int, ...] = (1_000, 10_000)
 
 
 FULL = Sizes()
@@ -106,7 +110,7 @@ QUICK = Sizes(
     tumbling_steps=200, record_every=100, bodies=64, body_steps=50, mujoco_seconds=0.02, repeat=1,
     cold_start=False, cold_start_bodies=8, pile_boxes=27, pile_seconds=0.2, pyramid_base=4, pyramid_seconds=0.2,
     cubes_boxes=(8, 27), cubes_seconds=0.2, big_pyramid_base=6, big_pyramid_seconds=0.2, chain_links=4,
-    chain_seconds=0.2, quadrotor_seconds=0.2, rotorpy_seconds=0.2,
+    chain_seconds=0.2, quadrotor_seconds=0.2, rotorpy_seconds=0.2, build_bodies=(100, 400), build_joints=(100, 400),
 )  # fmt: skip
 
 
@@ -576,6 +580,37 @@ def check_targets(results: dict[str, list[dict]]) -> list[dict]:
         if row["engine"] == "tumble" and row["controller"].startswith("SE3") and math.isfinite(row["x_rotorpy"]):
             add(f"quadrotor {row['rate_hz']} Hz, SE3 every step: steps/s vs RotorPy (x)", row["x_rotorpy"], ">= 100",
                 row["x_rotorpy"] >= 100)  # fmt: skip
+    targets += _build_targets(results.get("build", []))
+    return targets
+
+
+def _build_targets(rows: list[dict]) -> list[dict]:
+    """Issue 20's: 100 000 bodies and 10 000 joints built in under 5 s each, a scene file within 2x of the API, and
+    the cost per item growing no faster than linearly (the per-item time at the largest size within 1.5x of that at
+    a tenth of it: garbage collection and cache misses grow a little, a quadratic build grows 10x)."""
+    targets = []
+
+    def add(name, value, limit, met):
+        targets.append({"target": name, "value": value, "limit": limit, "met": "yes" if met else "NO"})
+
+    for case, size_key, limit in (("free bodies", "bodies", 100_000), ("chain", "joints", 10_000),
+                                  ("grid", "joints", 10_000)):  # fmt: skip
+        api = sorted((r for r in rows if r["case"] == case and r["how"] == "API"), key=lambda r: r[size_key])
+        if not api:
+            continue
+        largest = api[-1]
+        if largest[size_key] >= 0.99 * limit:
+            add(f"build {case}, {largest[size_key]} {size_key}, API (s)", largest["build_s"], "< 5",
+                largest["build_s"] < 5)  # fmt: skip
+        tenth = [r for r in api if 8 * r[size_key] <= largest[size_key] <= 12 * r[size_key]]
+        if tenth:
+            growth = largest["us_per_item"] / tenth[-1]["us_per_item"]
+            add(f"build {case}: per-item time, {tenth[-1][size_key]} -> {largest[size_key]} {size_key} (x)", growth,
+                "<= 1.5", growth <= 1.5)  # fmt: skip
+        for row in rows:
+            if row["case"] == case and row["how"] == "scene file":
+                add(f"build {case}, {row[size_key]} {size_key}: scene file vs API (x)", row["x_api"], "<= 2",
+                    row["x_api"] <= 2)  # fmt: skip
     return targets
 
 
@@ -662,6 +697,7 @@ BENCHMARKS: dict[str, Callable[[Sizes], list[dict]]] = {
         articulation.FULL if sizes.repeat > 1 else articulation.QUICK
     ),
     "quadrotor": quadrotor.bench_quadrotor,
+    "build": build.bench_build,
 }
 OPTIONAL = ("big_pyramid",)  # slow: run only when asked for with --only
 

@@ -15,7 +15,7 @@ REPO = Path(__file__).resolve().parent.parent
 if str(REPO) not in sys.path:
     sys.path.insert(0, str(REPO))
 
-from benchmarks import joints, peers, quadrotor, run  # noqa: E402
+from benchmarks import build, joints, peers, quadrotor, run  # noqa: E402
 
 TINY = run.Sizes(
     tumbling_steps=40, record_every=10, bodies=8, body_steps=5, mujoco_seconds=0.002, repeat=1,
@@ -220,3 +220,28 @@ def test_quadrotor_rows_for_every_controller_and_rate():
     _assert_finite_numbers([{k: v for k, v in r.items() if k not in ("rms_error_cm", "x_rotorpy")} for r in rows])
     tumble_rows = {(r["controller"], r["rate_hz"]) for r in rows if r["engine"] == "tumble"}
     assert len(tumble_rows) == 3 * len(quadrotor.RATES)
+
+
+def test_build_rows_for_every_world_and_way_and_the_same_world_each_way(tmp_path):
+    sizes = run.Sizes(**{**run.QUICK.__dict__, "build_bodies": (30, 120), "build_joints": (30,)})
+    rows = build.bench_build(sizes)
+    _assert_finite_numbers([{k: v for k, v in r.items() if k != "x_mujoco"} for r in rows])
+    assert {(r["case"], r["how"]) for r in rows} == {
+        (case, how) for case in ("free bodies", "chain", "grid") for how in ("API", "scene file", "MuJoCo MJCF")
+    }
+    assert {r["bodies"] for r in rows if r["case"] == "free bodies"} == {31, 121}  # and the ground
+    assert {r["joints"] for r in rows if r["case"] == "grid"} == {2 * 4 * 3}  # the side-4 grid is closest to 30
+    # The scene file describes the world the API builds.
+    for case in ("free bodies", "chain", "grid"):
+        api = build.api_world(case, 30)
+        path = tmp_path / f"{case}.toml"
+        path.write_text(build.scene_toml(case, 30))
+        scene = tumble.scene_file.load(path).world
+        np.testing.assert_allclose(scene.state.body_pos, api.state.body_pos, atol=1e-12)
+        assert scene.model.joint_count == api.model.joint_count
+    targets = run._build_targets(rows)
+    assert any("scene file vs API" in t["target"] for t in targets)
+    mujoco = pytest.importorskip("mujoco")
+    for case in ("free bodies", "chain", "grid"):
+        model = mujoco.MjModel.from_xml_string(build.mjcf(case, 30))
+        assert model.nbody - 1 == build.api_world(case, 30).model.body_count - (case == "free bodies")

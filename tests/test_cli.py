@@ -349,3 +349,24 @@ def test_a_ctrl_c_that_python_drops_is_raised_again_at_the_next_chunk():
         with pytest.raises(KeyboardInterrupt):
             latch.check()
     assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
+
+
+def test_info_lists_the_first_rows_of_a_big_scene_and_all_with_all(tmp_path):
+    parts = ["[world]\n"]
+    parts += [f'[[bodies]]\nname = "b{i}"\nshape = {{ type = "sphere", radius = 0.1 }}\nmass = 1.0\n'
+              f"position = [{0.5 * i}, 0, 1]\n" for i in range(130)]  # fmt: skip
+    parts += [
+        f'[[joints]]\ntype = "ball"\na = "b{i}"\nb = "b{i + 1}"\nanchor = [{0.5 * i + 0.25}, 0, 1]\n'
+        for i in range(120)
+    ]
+    scene = tmp_path / "many.toml"
+    scene.write_text("\n".join(parts))
+    short = tumble_cli("info", scene)
+    assert short.returncode == 0, short.stderr
+    bodies_table = short.stdout.split("joints (")[0]
+    assert " b99 " in bodies_table and " b100 " not in bodies_table
+    assert "... and 30 more bodies (tumble info --all" in short.stdout
+    assert "... and 20 more joints" in short.stdout
+    full = tumble_cli("info", scene, "--all")
+    assert full.returncode == 0, full.stderr
+    assert " b129 " in full.stdout and "more bodies" not in full.stdout and "more joints" not in full.stdout

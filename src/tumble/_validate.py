@@ -61,7 +61,7 @@ def as_array(name: str, value, trailing_shape: tuple[int, ...], *, batch: bool =
     if not shape_ok or (not batch and array.ndim != k):
         expected = ("(..., " if batch else "(") + ", ".join(map(str, trailing_shape)) + ")"
         raise ValueError(f"{name} must have shape {expected}, got shape {array.shape}: {_show(array)}")
-    if not np.all(np.isfinite(array)):
+    if not np.isfinite(array).all():
         raise ValueError(f"{name} must be finite, got {_show(array)}")
     return array
 

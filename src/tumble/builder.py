@@ -20,6 +20,9 @@ from .shapes import Capsule, Cylinder, Sphere
 __all__ = ["JointSpec", "ModelBuilder", "ShapeSpec"]
 
 
+_ZERO3, _ZERO33 = np.zeros(3), np.zeros((3, 3))  # a static body's COM and inertia in the model's arrays
+
+
 @dataclass(frozen=True)
 class ShapeSpec:
     """One shape of a body, placed in the body frame (relative to the frame origin)."""
@@ -68,9 +71,29 @@ class ModelBuilder:
     rows: list[_BodyRow] = field(default_factory=list)
     joints: list[JointSpec] = field(default_factory=list)
 
+    def __post_init__(self) -> None:
+        # Name -> row, so that checking a new name and finding a body stay O(1) (not a field: derived from rows).
+        self._names = {row.name: i for i, row in enumerate(self.rows) if row.name is not None}
+
     @property
     def body_count(self) -> int:
         return len(self.rows)
+
+    def index_of(self, name: str) -> int | None:
+        """The row of the body called ``name``, or None."""
+        return self._names.get(name)
+
+    @property
+    def names(self) -> list[str]:
+        return list(self._names)
+
+    def mass_row(self, index: int) -> tuple[float, np.ndarray, np.ndarray, np.ndarray]:
+        """``(mass, com, inertia, inv_inertia)`` of one body, body frame, as :meth:`finalize` packs them (zeros for a
+        static body): what a handle reads before the model is built."""
+        mp = self.rows[index].mass_properties
+        if mp is None:
+            return 0.0, np.zeros(3), np.zeros((3, 3)), np.zeros((3, 3))
+        return float(mp.mass), np.asarray(mp.com, np.float64), mp.inertia, np.linalg.inv(mp.inertia)
 
     def add_body(
         self,
@@ -83,6 +106,8 @@ class ModelBuilder:
     ) -> int:
         """Append a body (``mass_properties=None`` for a static one); returns its row."""
         self.rows.append(_BodyRow(mass_properties, list(shapes), linear_damping, angular_damping, name))
+        if name is not None:
+            self._names[name] = len(self.rows) - 1
         return len(self.rows) - 1
 
     def add_joint(self, spec: JointSpec) -> int:
@@ -108,16 +133,13 @@ class ModelBuilder:
 
     def finalize(self, gravity: np.ndarray) -> Model:
         n = len(self.rows)
-        mass = np.zeros(n)
-        inertia = np.zeros((n, 3, 3))
+        mps = [row.mass_properties for row in self.rows]
+        mass = np.array([0.0 if mp is None else mp.mass for mp in mps], np.float64)
+        com = np.array([_ZERO3 if mp is None else mp.com for mp in mps], np.float64).reshape(n, 3)
+        inertia = np.array([_ZERO33 if mp is None else mp.inertia for mp in mps], np.float64).reshape(n, 3, 3)
         inv_inertia = np.zeros((n, 3, 3))
-        com = np.zeros((n, 3))
-        for i, row in enumerate(self.rows):
-            mp = row.mass_properties
-            if mp is not None:
-                mass[i], com[i], inertia[i] = mp.mass, mp.com, mp.inertia
-                inv_inertia[i] = np.linalg.inv(mp.inertia)
         is_dynamic = mass > 0.0
+        inv_inertia[is_dynamic] = np.linalg.inv(inertia[is_dynamic])  # as mass_row inverts one
         inv_mass = np.divide(1.0, mass, out=np.zeros(n), where=is_dynamic)
         specs = [(i, s) for i, row in enumerate(self.rows) for s in row.shapes]
         joints, joint_exclusions = self._joint_arrays()

@@ -230,17 +230,7 @@ def load_world(path: str | os.PathLike, cls=None):
     params, builder = decode(manifest["params"]), decode(manifest["builder"])
     state, inputs = decode(manifest["state"]), decode(manifest["inputs"])
     _check_consistent(builder, state, inputs, source)
-    world = cls(gravity=decode(manifest["gravity"]), integrator=params.integrator)
-    world._params = params
-    world._builder = builder
-    from .handles import Body, Joint
-
-    world._bodies = [Body(world, i) for i in range(builder.body_count)]
-    world._joints = [Joint(world, i) for i in range(len(builder.joints))]
-    world._state, world._inputs = state, inputs
-    world._model = None
-    world._sync()
-    return world
+    return cls._from_builder(builder, state, inputs, gravity=decode(manifest["gravity"]), params=params)
 
 
 def _check_consistent(builder: ModelBuilder, state: State, inputs: Inputs, source: str) -> None:

@@ -455,6 +455,14 @@ def _axis_label(column) -> str:
     return _vec(column, 3)
 
 
+INFO_ROWS = 100  # rows of a table ``tumble info`` prints unless --all; a scene of 100 000 bodies lists the first
+
+
+def _more(console, left_out: int, what: str) -> None:
+    if left_out > 0:
+        console.print(_text(f"... and {left_out} more {what} (tumble info --all lists every one)"))
+
+
 def _cmd_info(args) -> int:
     from rich.table import Table
 
@@ -477,7 +485,8 @@ def _cmd_info(args) -> int:
                           ("mass [kg]", "right"), ("COM [m] (world)", "left"),
                           ("principal moments [kg m²]", "left"), ("principal axes (body frame)", "left")):  # fmt: skip
         bodies.add_column(_text(name), justify=justify, no_wrap=name in ("name", "#"))
-    for i, body in enumerate(world.bodies):
+    listed = world.bodies if args.all else world.bodies[:INFO_ROWS]
+    for i, body in enumerate(listed):
         kinds = shape_kinds.get(i, [])
         shape = "+".join(kinds) if len(kinds) <= 3 else f"{len(kinds)} shapes"
         if body.is_static:
@@ -489,18 +498,20 @@ def _cmd_info(args) -> int:
                    _vec(moments), ", ".join(_axis_label(axes[:, j]) for j in range(3))]  # fmt: skip
         bodies.add_row(*map(_text, row))
     console.print(bodies)
+    _more(console, model.body_count - len(listed), "bodies")
 
     joints = world.joints
     if joints:
         table = Table(title=_text(f"joints ({len(joints)})"), title_justify="left")
         for name in ("#", "kind", "body a", "body b", "anchor [m] (world)"):
             table.add_column(_text(name))
-        for j, joint in enumerate(joints):
+        for j, joint in enumerate(joints if args.all else joints[:INFO_ROWS]):
             b = joint.body_b
             label_a = joint.body_a.name or f"#{joint.body_a.index}"
             label_b = "world" if b is None else (b.name or f"#{b.index}")
             table.add_row(*map(_text, (j, joint.kind, label_a, label_b, _vec(joint.anchor_a))))
         console.print(table)
+        _more(console, len(joints) - table.row_count, "joints")
     else:
         console.print(_text("joints: none"))
 
@@ -789,6 +800,7 @@ def build_parser() -> argparse.ArgumentParser:
                                description="Load a scene file and print its bodies (mass, centre of mass, principal "
                                "moments and axes), joints and settings.")  # fmt: skip
     info.add_argument("scene", metavar="SCENE")
+    info.add_argument("--all", action="store_true", help=f"list every body and joint (default: the first {INFO_ROWS})")
     info.set_defaults(handler=_cmd_info)
 
     view = commands.add_parser("view", help="write the HTML replay of a trajectory file",

@@ -39,21 +39,20 @@ class Body:
     def is_static(self) -> bool:
         return self._world._builder.rows[self._index].mass_properties is None
 
-    def _state(self):
-        return self._world.state
+    def _row(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """``(com, quat, linvel, angmom)``: writable views of this body's row (``World._body_row``)."""
+        return self._world._body_row(self._index)
 
-    def _model(self):
-        return self._world.model
-
-    def _com_local(self) -> np.ndarray:
-        return self._model().body_com_local[self._index]
+    def _mass(self) -> tuple[float, np.ndarray, np.ndarray, np.ndarray]:
+        """``(mass, com_local, inertia, inv_inertia)`` in the body frame (``World._mass_row``)."""
+        return self._world._mass_row(self._index)
 
     def _require_dynamic(self, what: str) -> None:
         """Refuse to move a static body; wake a sleeping one (with its island), since it is about to move."""
         if self.is_static:
             raise ValueError(f"{what}: body {self.name or self._index!r} is static and cannot move")
-        s = self._state()
-        if s.body_sleeping[self._index]:
+        s = self._world._state
+        if self._index < s.body_count and s.body_sleeping[self._index]:  # a body not yet stepped is awake
             island = s.body_island == s.body_island[self._index]
             s.body_sleeping[island] = False
             s.body_sleep_time[island] = 0.0
@@ -61,27 +60,28 @@ class Body:
     @property
     def sleeping(self) -> bool:
         """Whether the body sleeps (is at rest and not simulated until touched or pushed)."""
-        return bool(self._state().body_sleeping[self._index])
+        s = self._world._state
+        return bool(self._index < s.body_count and s.body_sleeping[self._index])
 
     # --- pose and velocity --------------------------------------------------------------------------
 
     @property
     def position(self) -> np.ndarray:
         """The body frame's origin [m], world frame."""
-        s = self._state()
-        return s.body_pos[self._index] - quat_rotate(s.body_quat[self._index], self._com_local())
+        com, quat, _, _ = self._row()
+        return com - quat_rotate(quat, self._mass()[1])
 
     @position.setter
     def position(self, value) -> None:
         value = as_vector3("position", value)
         self._require_dynamic("position")
-        s = self._state()
-        s.body_pos[self._index] = value + quat_rotate(s.body_quat[self._index], self._com_local())
+        com, quat, _, _ = self._row()
+        com[:] = value + quat_rotate(quat, self._mass()[1])
 
     @property
     def orientation(self) -> np.ndarray:
         """Unit quaternion ``[w, x, y, z]``, body to world."""
-        return self._state().body_quat[self._index].copy()
+        return self._row()[1].copy()
 
     @orientation.setter
     def orientation(self, value) -> None:
@@ -89,43 +89,43 @@ class Body:
         quat = as_quaternion("orientation", value)
         self._require_dynamic("orientation")
         origin = self.position
-        s = self._state()
-        s.body_quat[self._index] = quat
-        s.body_pos[self._index] = origin + quat_rotate(quat, self._com_local())
+        com, row_quat, _, _ = self._row()
+        row_quat[:] = quat
+        com[:] = origin + quat_rotate(quat, self._mass()[1])
 
     @property
     def rotation(self) -> np.ndarray:
         """The 3x3 rotation matrix, body to world."""
-        return quat_to_matrix(self._state().body_quat[self._index])
+        return quat_to_matrix(self._row()[1])
 
     @property
     def center_of_mass(self) -> np.ndarray:
         """[m], world frame."""
-        return self._state().body_pos[self._index].copy()
+        return self._row()[0].copy()
 
     @property
     def velocity(self) -> np.ndarray:
         """Velocity of the centre of mass [m/s], world frame."""
-        return self._state().body_linvel[self._index].copy()
+        return self._row()[2].copy()
 
     @velocity.setter
     def velocity(self, value) -> None:
         value = as_vector3("velocity", value)
         self._require_dynamic("velocity")
-        self._state().body_linvel[self._index] = value
+        self._row()[2][:] = value
 
     @property
     def angular_velocity(self) -> np.ndarray:
         """ω = R I⁻¹ Rᵀ L [rad/s], world frame (the state holds the angular momentum ``L``)."""
         r = self.rotation
-        inv_inertia = self._model().body_inv_inertia_local[self._index]
-        return r @ (inv_inertia @ (r.T @ self._state().body_angmom[self._index]))
+        inv_inertia = self._mass()[3]
+        return r @ (inv_inertia @ (r.T @ self._row()[3]))
 
     @angular_velocity.setter
     def angular_velocity(self, value) -> None:
         value = as_vector3("angular_velocity", value)
         self._require_dynamic("angular_velocity")
-        self._state().body_angmom[self._index] = self.inertia_world @ value
+        self._row()[3][:] = self.inertia_world @ value
 
     @property
     def angular_velocity_body(self) -> np.ndarray:
@@ -135,26 +135,26 @@ class Body:
     def point_velocity(self, point) -> np.ndarray:
         """Velocity of the body-fixed point now at world ``point``: ``v + ω × (p − x_com)`` [m/s]."""
         point = as_vector3("point", point)
-        s = self._state()
-        return s.body_linvel[self._index] + np.cross(self.angular_velocity, point - s.body_pos[self._index])
+        com, _, linvel, _ = self._row()
+        return linvel + np.cross(self.angular_velocity, point - com)
 
     # --- mass ---------------------------------------------------------------------------------------
 
     @property
     def mass(self) -> float:
         """[kg]; 0 for a static body."""
-        return float(self._model().body_mass[self._index])
+        return float(self._mass()[0])
 
     @property
     def inertia_body(self) -> np.ndarray:
         """Inertia tensor about the COM in the body frame [kg m²]."""
-        return self._model().body_inertia_local[self._index].copy()
+        return np.array(self._mass()[2])
 
     @property
     def inertia_world(self) -> np.ndarray:
         """``R I Rᵀ`` [kg m²], about the COM."""
         r = self.rotation
-        return r @ self._model().body_inertia_local[self._index] @ r.T
+        return r @ self._mass()[2] @ r.T
 
     @property
     def linear_momentum(self) -> np.ndarray:
@@ -163,7 +163,7 @@ class Body:
     @property
     def angular_momentum(self) -> np.ndarray:
         """``L = R I Rᵀ ω`` about the COM [kg m²/s], world frame."""
-        return self._state().body_angmom[self._index].copy()
+        return self._row()[3].copy()
 
     @property
     def kinetic_energy(self) -> float:
@@ -176,7 +176,7 @@ class Body:
     def _lever(self, point) -> np.ndarray:
         if point is None:
             return np.zeros(3)
-        return as_vector3("point", point) - self._state().body_pos[self._index]
+        return as_vector3("point", point) - self._row()[0]
 
     def apply_force(self, force, point=None) -> None:
         """Apply ``force`` [N] at world ``point`` (default the COM) during the next step only."""
@@ -231,9 +231,10 @@ class Body:
         impulse = as_vector3("impulse", impulse)
         lever = self._lever(point)
         self._require_dynamic("apply_impulse")
-        s = self._state()
-        s.body_linvel[self._index] += impulse * self._model().body_inv_mass[self._index]
-        s.body_angmom[self._index] += np.cross(lever, impulse)
+        inv_mass = 1.0 / self.mass  # as the model's body_inv_mass holds it
+        _, _, linvel, angmom = self._row()
+        linvel += impulse * inv_mass
+        angmom += np.cross(lever, impulse)
 
     def __eq__(self, other) -> bool:
         return isinstance(other, Body) and other._world is self._world and other._index == self._index
@@ -290,8 +291,8 @@ class Joint:
     def _anchor(self, body: int, local: np.ndarray) -> np.ndarray:
         if body < 0:
             return local.copy()
-        s = self._world.state
-        return s.body_pos[body] + quat_rotate(s.body_quat[body], local)
+        com, quat, _, _ = self._world._body_row(body)
+        return com + quat_rotate(quat, local)
 
     @property
     def anchor_a(self) -> np.ndarray:

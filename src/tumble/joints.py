@@ -273,8 +273,8 @@ def _world_pose(world, body) -> tuple[np.ndarray, np.ndarray]:
     """COM and orientation of ``body`` now (the world frame for None)."""
     if body is None:
         return np.zeros(3), np.array([1.0, 0.0, 0.0, 0.0])
-    state = world.state
-    return state.body_pos[body.index].copy(), state.body_quat[body.index].copy()
+    com, quat, _, _ = world._body_row(body.index)
+    return com.copy(), quat.copy()
 
 
 def _frame_with_x_along(axis: np.ndarray) -> np.ndarray:

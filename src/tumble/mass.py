@@ -108,6 +108,15 @@ class MassProperties:
         object.__setattr__(self, "_com", _readonly(as_vector3("com", com)))
         object.__setattr__(self, "_inertia", _readonly(_check_inertia(inertia)))
 
+    @classmethod
+    def _trusted(cls, mass: float, com: np.ndarray, inertia: np.ndarray) -> MassProperties:
+        """One made from a valid one by a change that keeps it valid (a positive scale), without checking again."""
+        out = object.__new__(cls)
+        object.__setattr__(out, "_mass", float(mass))
+        object.__setattr__(out, "_com", _readonly(com))
+        object.__setattr__(out, "_inertia", _readonly(inertia))
+        return out
+
     def __setattr__(self, name, value):
         raise AttributeError(f"MassProperties is immutable; cannot set {name!r} (build a new one instead)")
 
@@ -197,7 +206,7 @@ class MassProperties:
     def scaled_to(self, mass) -> MassProperties:
         """The same shape with total mass ``mass`` [kg]: the inertia scales with the mass."""
         new_mass = as_float("mass", mass, positive=True)
-        return MassProperties(new_mass, self._com, self._inertia * (new_mass / self._mass))
+        return MassProperties._trusted(new_mass, self._com, self._inertia * (new_mass / self._mass))
 
     # --- composites ----------------------------------------------------------------------------------
 
@@ -250,7 +259,13 @@ def _total_mass(mass, density, measure: float) -> float:
 
 
 def _diagonal(mass: float, moments, com=(0.0, 0.0, 0.0)) -> MassProperties:
-    return MassProperties(mass, com, np.diag(np.asarray(moments, dtype=np.float64)))
+    """The primitives' formulas give a valid tensor for valid sizes, so only an overflow or underflow of the mass
+    or the moments is looked for (by the checked constructor, which then raises); bodies are built by the
+    hundred thousand, and this is on their way."""
+    inertia = np.diag(np.asarray(moments, dtype=np.float64))
+    if math.isfinite(mass) and mass > 0.0 and np.isfinite(inertia).all() and (inertia >= 0.0).all():
+        return MassProperties._trusted(mass, np.asarray(com, dtype=np.float64), inertia)
+    return MassProperties(mass, com, inertia)
 
 
 def solid_sphere(radius, *, mass=None, density=None) -> MassProperties:
@@ -292,7 +307,7 @@ def solid_ellipsoid(a, b, c, *, mass=None, density=None) -> MassProperties:
 
 def _positive_extents(extents) -> np.ndarray:
     sizes = as_vector3("extents", extents)
-    if not np.all(sizes > 0.0):
+    if not (sizes > 0.0).all():
         raise ValueError(f"extents must be > 0 (full edge lengths along x, y, z), got {_show(sizes)}")
     return sizes
 

@@ -67,6 +67,11 @@ def _unit_direction(direction) -> np.ndarray:
     return as_unit_vector3("direction", direction, tiny=0.0)
 
 
+# Unit-density mass properties of primitives by (type, params): see Shape._unit_mass_properties.
+_UNIT_MASS: dict[tuple[int, bytes], _mass.MassProperties] = {}
+_UNIT_MASS_SIZE = 4096
+
+
 class Shape:
     """Base of all shapes: an immutable value with kernel-ready data.
 
@@ -77,7 +82,7 @@ class Shape:
         faces: (f, 3) int64 vertex indices for ``ConvexHull`` and ``TriMesh``, else None (read-only).
     """
 
-    __slots__ = ("_params", "_vertices", "_faces", "_volume")
+    __slots__ = ("_params", "_vertices", "_faces", "_volume", "_unit_mass")
     type: ShapeType
 
     def _init(self, params, vertices=None, faces=None, volume=math.nan) -> None:
@@ -85,6 +90,24 @@ class Shape:
         object.__setattr__(self, "_vertices", None if vertices is None else _frozen(vertices))
         object.__setattr__(self, "_faces", None if faces is None else _frozen(faces))
         object.__setattr__(self, "_volume", float(volume))
+        object.__setattr__(self, "_unit_mass", None)
+        if math.isinf(volume) and self.type != ShapeType.PLANE:
+            raise ValueError(f"{self!r} is too large: its volume overflows a float (inf)")
+
+    def _unit_mass_properties(self) -> _mass.MassProperties:
+        """``mass_properties(density=1.0)``, worked out once per shape, and once per size for the primitives (a
+        shape is immutable; a scene of many bodies holds a few sizes, often as a new shape object per body)."""
+        if self._unit_mass is None:
+            key = (int(self.type), self._params.tobytes()) if self._vertices is None else None
+            mp = _UNIT_MASS.get(key) if key is not None else None
+            if mp is None:
+                mp = self.mass_properties(density=1.0)
+                if key is not None:
+                    if len(_UNIT_MASS) >= _UNIT_MASS_SIZE:
+                        _UNIT_MASS.clear()
+                    _UNIT_MASS[key] = mp
+            object.__setattr__(self, "_unit_mass", mp)
+        return self._unit_mass
 
     def __setattr__(self, name, value):
         raise AttributeError(f"{type(self).__name__} is immutable; cannot set {name!r} (make a new shape)")
@@ -162,7 +185,7 @@ class Sphere(Shape):
 
     def __init__(self, radius) -> None:
         r = as_float("radius", radius, positive=True)
-        self._init((r, 0.0, 0.0, 0.0), volume=4.0 / 3.0 * math.pi * r**3)
+        self._init((r, 0.0, 0.0, 0.0), volume=4.0 / 3.0 * math.pi * r * r * r)
 
     @property
     def radius(self) -> float:
@@ -190,9 +213,9 @@ class Box(Shape):
 
     def __init__(self, extents) -> None:
         sizes = as_vector3("extents", extents)
-        if not np.all(sizes > 0.0):
+        if not (sizes > 0.0).all():
             raise ValueError(f"extents must be > 0 (full edge lengths along x, y, z), got {sizes.tolist()}")
-        self._init((*(0.5 * sizes), 0.0), volume=float(np.prod(sizes)))
+        self._init((*(0.5 * sizes), 0.0), volume=math.prod(sizes.tolist()))
 
     @property
     def extents(self) -> np.ndarray:
@@ -232,7 +255,7 @@ class Capsule(Shape):
     def __init__(self, radius, length) -> None:
         r = as_float("radius", radius, positive=True)
         length_ = as_float("length", length, nonnegative=True)
-        volume = math.pi * r * r * length_ + 4.0 / 3.0 * math.pi * r**3
+        volume = math.pi * r * r * length_ + 4.0 / 3.0 * math.pi * r * r * r
         self._init((r, 0.5 * length_, 0.0, 0.0), volume=volume)
 
     @property

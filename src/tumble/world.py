@@ -1,8 +1,10 @@
 """World: the Pythonic facade over the model, state and inputs arrays.
 
-``add_*`` calls go to a :class:`~tumble.builder.ModelBuilder`; the arrays are rebuilt lazily the next time
-they are needed, so adding thousands of bodies costs linear time. ``world.state`` exposes the arrays for
-batch work (re-read it after adding bodies: adding reallocates them).
+``add_*`` calls write rows to a :class:`~tumble.builder.ModelBuilder`; the model is packed once, before the
+first step or query that needs it, so building costs linear time. A handle reads and writes its own row (the
+builder's, or the state's once the row is there) without packing anything. ``world.state`` exposes the arrays
+for batch work; reading it appends the rows of bodies added since (re-read it after adding bodies: adding
+reallocates them), without packing the model.
 """
 
 from __future__ import annotations
@@ -119,15 +121,22 @@ def _body_mass_properties(items: list[ShapeSpec], mass, density, inertia) -> Mas
         return MassProperties(as_float("mass", mass, positive=True), np.zeros(3), inertia)
     kind, value = mass_or_density(mass, density)
     per_volume = value if kind == "density" else 1.0
-    mp = sum(
-        it.shape.mass_properties(density=per_volume).transformed(rotation=it.quat, translation=it.position)
-        for it in items
-    )
+    mp = sum(_placed_mass_properties(it, per_volume) for it in items)
     if kind == "mass":
         mp = mp.scaled_to(value)
     if inertia is not None:
         mp = MassProperties(mp.mass, mp.com, inertia)
     return mp
+
+
+def _placed_mass_properties(item: ShapeSpec, density: float) -> MassProperties:
+    """One shape's mass properties in the body frame (as given when the shape frame is the body frame: most
+    bodies, and moving them would only cost time)."""
+    shape = item.shape
+    mp = shape._unit_mass_properties() if density == 1.0 else shape.mass_properties(density=density)
+    if np.array_equal(item.quat, _IDENTITY) and not item.position.any():
+        return mp
+    return mp.transformed(rotation=item.quat, translation=item.position)
 
 
 def _explicit_mass_properties(mass_properties, mass, density, inertia) -> MassProperties | None:
@@ -210,6 +219,17 @@ class World:
         self._wind: Wind | None = None
         self._vehicles: list = []  # tumble.vehicles.Quadrotor, each one body with its actuators
 
+    @classmethod
+    def _from_builder(cls, builder: ModelBuilder, state: State, inputs: Inputs, *, gravity, params: Params) -> World:
+        """A world over a filled builder and the state of its rows (a checkpoint's): handles made, model packed."""
+        world = cls(gravity=gravity, integrator=params.integrator)
+        world._params, world._builder = params, builder
+        world._bodies = [Body(world, i) for i in range(builder.body_count)]
+        world._joints = [Joint(world, i) for i in range(len(builder.joints))]
+        world._state, world._inputs = state, inputs
+        world._sync()
+        return world
+
     # --- building -----------------------------------------------------------------------------------
 
     def add_body(
@@ -259,8 +279,13 @@ class World:
         if mp is None:
             mp = _body_mass_properties(items, mass, density, inertia)
         _require_definite(mp)
-        com = position + quat_rotate(quat, mp.com)
-        angmom = diagnostics.world_tensor_apply(mp.inertia[None], quat[None], angular_velocity[None])[0]
+        # Skipping the rotations of zero vectors (the usual COM at the origin, a body at rest) keeps building cheap.
+        com = position + quat_rotate(quat, mp.com) if mp.com.any() else position
+        angmom = (
+            diagnostics.world_tensor_apply(mp.inertia[None], quat[None], angular_velocity[None])[0]
+            if angular_velocity.any()
+            else np.zeros(3)
+        )
         index = self._builder.add_body(
             mp, items, linear_damping=linear_damping, angular_damping=angular_damping, name=name
         )
@@ -392,26 +417,37 @@ class World:
             return None
         if not isinstance(name, str) or not name:
             raise TypeError(f"name must be a non-empty string or None, got {name!r}")
-        if name in self._builder_names():
+        if self._builder.index_of(name) is not None:
             raise ValueError(f"name must be unique in the world, {name!r} is already taken")
         return name
 
-    def _builder_names(self) -> set[str]:
-        return {row.name for row in self._builder.rows if row.name is not None}
-
     def _append(self, index, com, quat, velocity, angmom) -> Body:
-        self._pending.append((com, quat, velocity, angmom))
+        self._pending.append(tuple(np.array(v, np.float64) for v in (com, quat, velocity, angmom)))
         self._model = None
         body = Body(self, index)
         self._bodies.append(body)
         return body
 
-    def _sync(self) -> None:
-        """Rebuild the model and grow the state after ``add_*`` calls."""
-        if self._model is not None:
-            return
-        self._model = self._builder.finalize(self._gravity)
-        self._scratch = Scratch.for_world(self._model.body_count, self._model.shape_count, self._model.joint_count)
+    def _body_row(self, index: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """``(com, quat, linvel, angmom)`` of one body as writable views, whether or not its row has reached the
+        state yet: what a handle reads and writes while the world is being built, without growing the state or
+        rebuilding the model (which would make building quadratic)."""
+        s = self._state
+        if index < s.body_count:
+            return s.body_pos[index], s.body_quat[index], s.body_linvel[index], s.body_angmom[index]
+        return self._pending[index - s.body_count]
+
+    def _mass_row(self, index: int) -> tuple[float, np.ndarray, np.ndarray, np.ndarray]:
+        """``(mass, com, inertia, inv_inertia)`` of one body, body frame: the model's row when it is built, else the
+        builder's (so that a handle's read never builds the model)."""
+        m = self._model
+        if m is None:
+            return self._builder.mass_row(index)
+        return m.body_mass[index], m.body_com_local[index], m.body_inertia_local[index], m.body_inv_inertia_local[index]
+
+    def _grow(self) -> None:
+        """Append the state and input rows of the bodies added since, and zero impulses for the joints added since;
+        the model is left as it is."""
         if self._pending:
             self._state = self._state.grown(*(np.array(column) for column in zip(*self._pending, strict=True)))
             added = Inputs.zeros(len(self._pending))
@@ -420,7 +456,15 @@ class World:
                 np.concatenate([self._inputs.body_torque, added.body_torque]),
             )
             self._pending.clear()
-        self._state.with_joints(self._model.joint_count)
+        self._state.with_joints(len(self._builder.joints))
+
+    def _sync(self) -> None:
+        """Grow the state and build the model once after ``add_*`` calls, before a step or a query needs them."""
+        self._grow()
+        if self._model is not None:
+            return
+        self._model = self._builder.finalize(self._gravity)
+        self._scratch = Scratch.for_world(self._model.body_count, self._model.shape_count, self._model.joint_count)
 
     # --- arrays -------------------------------------------------------------------------------------
 
@@ -433,13 +477,13 @@ class World:
     @property
     def state(self) -> State:
         """The dynamic arrays (``body_pos`` is the COM); views, for batch reads and writes."""
-        self._sync()
+        self._grow()
         return self._state
 
     @property
     def inputs(self) -> Inputs:
         """The applied forces and torques of the next step."""
-        self._sync()
+        self._grow()
         return self._inputs
 
     @property
@@ -449,10 +493,10 @@ class World:
 
     def body(self, name: str) -> Body:
         """The body called ``name``."""
-        for b in self._bodies:
-            if b.name == name:
-                return b
-        raise KeyError(f"no body named {name!r}; names: {sorted(self._builder_names())}")
+        index = self._builder.index_of(name) if isinstance(name, str) else None
+        if index is None:
+            raise KeyError(f"no body named {name!r}; names: {sorted(self._builder.names)}")
+        return self._bodies[index]
 
     @property
     def gravity(self) -> np.ndarray:
@@ -717,8 +761,8 @@ class World:
 
     def kinetic_energy(self) -> float:
         """Σ ½ m |v|² + ½ ω·L [J]."""
-        s = self.state
         omega = self.angular_velocities()
+        s = self._state
         return float(diagnostics.kinetic_energy(self._model.body_mass, s.body_linvel, omega, s.body_angmom).sum())
 
     def potential_energy(self) -> float:
@@ -735,8 +779,8 @@ class World:
     def angular_momentum(self, point=(0.0, 0.0, 0.0)) -> np.ndarray:
         """Σ (x − p) × m v + L about ``point`` [kg m²/s], world frame (``L`` each body's spin)."""
         point = as_vector3("point", point)
-        s = self.state
-        return diagnostics.angular_momentum(self._model.body_mass, s.body_pos, s.body_linvel, s.body_angmom, point)
+        m, s = self.model, self._state
+        return diagnostics.angular_momentum(m.body_mass, s.body_pos, s.body_linvel, s.body_angmom, point)
 
     # --- queries ------------------------------------------------------------------------------------
 

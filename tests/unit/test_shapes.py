@@ -313,3 +313,13 @@ def test_equal_shapes_are_equal_values():
     assert hash(Sphere(1.0)) == hash(Sphere(1))
     assert Sphere(1.0) != Sphere(1.1)
     assert Cylinder(0.5, 1.0) != Capsule(0.5, 1.0)  # same params, different kinds
+
+
+@pytest.mark.parametrize(
+    "make",
+    [lambda: Sphere(5.6e102), lambda: Box((1e200, 1e200, 1e200)), lambda: Capsule(1e103, 1.0),
+     lambda: Cylinder(1e200, 1e200)],
+)  # fmt: skip
+def test_a_shape_whose_volume_overflows_is_refused_by_name(make):
+    with pytest.raises(ValueError, match=r"is too large: its volume overflows"):
+        make()

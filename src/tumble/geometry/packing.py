@@ -108,55 +108,62 @@ def _boundary_loop(triangles: np.ndarray) -> np.ndarray:
     return np.array(loop, dtype=np.int64)
 
 
-def _rotation_abs(quat: np.ndarray) -> np.ndarray:
-    from ..rotation import quat_to_matrix
-
-    return np.abs(quat_to_matrix(quat))
-
-
 def pack_geometry(shapes: list[Shape], shape_body, pos_local: np.ndarray, quat_local: np.ndarray) -> GeometryArrays:
-    """Pack shapes placed in their bodies (``pos_local`` relative to the body COM) into :class:`GeometryArrays`."""
+    """Pack shapes placed in their bodies (``pos_local`` relative to the body COM) into :class:`GeometryArrays`.
+
+    A hull or mesh object used by many shapes is packed once: its shapes share its vertex, face and edge ranges.
+    """
+    from ..rotation import quat_rotate, quat_to_matrix
+
     n = len(shapes)
+    pos_local = np.asarray(pos_local, dtype=np.float64).reshape(n, 3)
+    quat_local = np.asarray(quat_local, dtype=np.float64).reshape(n, 4)
     vertex_blocks, loops, normals, offsets, edges = [], [], [], [], []
     v_start, v_count = np.zeros(n, np.int64), np.zeros(n, np.int64)
     f_start, f_count = np.zeros(n, np.int64), np.zeros(n, np.int64)
     e_start, e_count = np.zeros(n, np.int64), np.zeros(n, np.int64)
-    centers, halves = np.zeros((n, 3)), np.zeros((n, 3))
+    packed: dict[int, int] = {}  # id of a hull or mesh -> the first shape that packed it
     v_total = 0
-    from ..rotation import quat_rotate
-
     for k, shape in enumerate(shapes):
+        if not isinstance(shape, (ConvexHull, TriMesh)):
+            v_start[k], f_start[k], e_start[k] = v_total, len(loops), len(edges)
+            continue
+        first = packed.setdefault(id(shape), k)
+        if first != k:
+            v_start[k], v_count[k], f_start[k] = v_start[first], v_count[first], f_start[first]
+            f_count[k], e_start[k], e_count[k] = f_count[first], e_start[first], e_count[first]
+            continue
         v_start[k], f_start[k], e_start[k] = v_total, len(loops), len(edges)
-        if isinstance(shape, (ConvexHull, TriMesh)):
-            vertices = np.asarray(shape.vertices, dtype=np.float64)
-            vertex_blocks.append(vertices)
-            v_count[k] = len(vertices)
-            if isinstance(shape, ConvexHull):
-                shape_loops, shape_normals, shape_offsets = hull_polygons(vertices, np.asarray(shape.faces))
-                undirected = {
-                    tuple(sorted((int(f[i]), int(f[(i + 1) % len(f)])))) for f in shape_loops for i in range(len(f))
-                }
-                edges.extend((a + v_total, b + v_total) for a, b in sorted(undirected))
-            else:
-                faces = np.asarray(shape.faces, dtype=np.int64)
-                shape_loops = list(faces)
-                p0, p1, p2 = (vertices[faces[:, i]] for i in range(3))
-                shape_normals = np.cross(p1 - p0, p2 - p0)
-                lengths = np.linalg.norm(shape_normals, axis=1, keepdims=True)
-                shape_normals = shape_normals / np.where(lengths > 0.0, lengths, 1.0)
-                shape_offsets = np.einsum("ij,ij->i", shape_normals, p0)
-            loops.extend(loop + v_total for loop in shape_loops)
-            normals.extend(shape_normals)
-            offsets.extend(shape_offsets)
-            v_total += len(vertices)
-        f_count[k], e_count[k] = len(loops) - f_start[k], len(edges) - e_start[k]
-        # Bounds in the body frame: the shape's local box turned by its local rotation (|R| h).
-        lo, hi = shape.local_bounds()
-        if shape.type == ShapeType.PLANE:
-            centers[k], halves[k] = pos_local[k], np.inf
+        vertices = np.asarray(shape.vertices, dtype=np.float64)
+        vertex_blocks.append(vertices)
+        v_count[k] = len(vertices)
+        if isinstance(shape, ConvexHull):
+            shape_loops, shape_normals, shape_offsets = hull_polygons(vertices, np.asarray(shape.faces))
+            undirected = {
+                tuple(sorted((int(f[i]), int(f[(i + 1) % len(f)])))) for f in shape_loops for i in range(len(f))
+            }
+            edges.extend((a + v_total, b + v_total) for a, b in sorted(undirected))
         else:
-            centers[k] = pos_local[k] + quat_rotate(quat_local[k], 0.5 * (lo + hi))
-            halves[k] = _rotation_abs(quat_local[k]) @ (0.5 * (hi - lo))
+            faces = np.asarray(shape.faces, dtype=np.int64)
+            shape_loops = list(faces)
+            p0, p1, p2 = (vertices[faces[:, i]] for i in range(3))
+            shape_normals = np.cross(p1 - p0, p2 - p0)
+            lengths = np.linalg.norm(shape_normals, axis=1, keepdims=True)
+            shape_normals = shape_normals / np.where(lengths > 0.0, lengths, 1.0)
+            shape_offsets = np.einsum("ij,ij->i", shape_normals, p0)
+        loops.extend(loop + v_total for loop in shape_loops)
+        normals.extend(shape_normals)
+        offsets.extend(shape_offsets)
+        v_total += len(vertices)
+        f_count[k], e_count[k] = len(loops) - f_start[k], len(edges) - e_start[k]
+    # Bounds in the body frame: each shape's local box turned by its local rotation (centre R c, half-widths |R| h).
+    # A plane is unbounded: its box is centred on its origin, infinite.
+    bounded = np.array([shape.type != ShapeType.PLANE for shape in shapes], bool).reshape(n)
+    bounds = np.array([np.concatenate(s.local_bounds()) for s, b in zip(shapes, bounded, strict=True) if b], np.float64)
+    lo, hi = bounds.reshape(-1, 6)[:, :3], bounds.reshape(-1, 6)[:, 3:]
+    centers, halves = pos_local.copy(), np.full((n, 3), np.inf)
+    centers[bounded] += quat_rotate(quat_local[bounded], 0.5 * (lo + hi))
+    halves[bounded] = np.einsum("nij,nj->ni", np.abs(quat_to_matrix(quat_local[bounded])), 0.5 * (hi - lo))
     loop_counts = np.array([len(lp) for lp in loops], dtype=np.int64)
     loop_starts = (
         np.concatenate([[0], np.cumsum(loop_counts)[:-1]]).astype(np.int64) if loops else np.zeros(0, np.int64)
@@ -165,8 +172,8 @@ def pack_geometry(shapes: list[Shape], shape_body, pos_local: np.ndarray, quat_l
         shape_type=np.array([int(s.type) for s in shapes], dtype=np.int64),
         shape_params=np.array([s.params for s in shapes], dtype=np.float64).reshape(n, 4),
         shape_body=np.asarray(shape_body, dtype=np.int64).reshape(n),
-        shape_pos_local=np.asarray(pos_local, dtype=np.float64).reshape(n, 3),
-        shape_quat_local=np.asarray(quat_local, dtype=np.float64).reshape(n, 4),
+        shape_pos_local=pos_local,
+        shape_quat_local=quat_local,
         shape_aabb_center_local=centers,
         shape_aabb_half_local=halves,
         vertex_local=np.concatenate(vertex_blocks) if vertex_blocks else np.zeros((0, 3)),

@@ -69,15 +69,13 @@ def _geometry(item: schema._Placed, base: Path, place: str, label: str):
     return None
 
 
-def _material(item: schema._Placed, scene: schema.Scene, place: str, label: str) -> dict:
-    base = schema.Material()
-    if item.material is not None:
-        if item.material not in scene.materials:
-            raise SceneError(
-                f"{label}: {place}.material: no material {item.material!r}; materials: {sorted(scene.materials)}"
-            )
-        base = scene.materials[item.material]
-    values = base.model_dump()
+def _material(item: schema._Placed, materials: dict[str | None, dict], place: str, label: str) -> dict:
+    """The item's friction, restitution and rolling resistance: its named material (``materials``: each one's
+    values, ``None`` the default's) with what the item gives itself on top."""
+    if item.material not in materials:
+        known = sorted(name for name in materials if name is not None)
+        raise SceneError(f"{label}: {place}.material: no material {item.material!r}; materials: {known}")
+    values = dict(materials[item.material])
     for key in values:
         given = getattr(item, key)
         if given is not None:
@@ -155,6 +153,7 @@ def build_world(scene: schema.Scene, base: Path, label: str) -> World:
                                           "joint_damping_ratio", "sleep"}, exclude_none=True)  # fmt: skip
     world = World(settings.gravity, integrator=settings.integrator, **solver)
     named: dict = {}
+    materials = {None: schema.Material().model_dump()} | {k: m.model_dump() for k, m in scene.materials.items()}
     for kind, items in (("bodies", scene.bodies), ("vehicles", scene.vehicles), ("static", scene.static)):
         if kind == "vehicles":  # after the bodies, before the static geometry: the order to_scene writes them in
             named.update(_vehicles(world, items, label))
@@ -169,7 +168,7 @@ def build_world(scene: schema.Scene, base: Path, label: str) -> World:
                     "orientation": item.orientation,
                     "collision_group": item.collision_group,
                     "collision_mask": item.collision_mask,
-                    **_material(item, scene, place, label),
+                    **_material(item, materials, place, label),
                 }
                 if kind == "bodies":
                     inertia = None if item.inertia is None else np.array(item.inertia, float)
