@@ -15,7 +15,7 @@ from .geometry.broad_phase import exclusion_table
 from .geometry.packing import pack_geometry
 from .mass import MassProperties
 from .model import Model
-from .shapes import Capsule, Cylinder, Sphere
+from .shapes import ShapeType
 
 __all__ = ["JointSpec", "ModelBuilder", "ShapeSpec"]
 
@@ -23,7 +23,7 @@ __all__ = ["JointSpec", "ModelBuilder", "ShapeSpec"]
 _ZERO3, _ZERO33 = np.zeros(3), np.zeros((3, 3))  # a static body's COM and inertia in the model's arrays
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, slots=True)  # slots: a world holds one per shape, and fewer objects for the GC to walk
 class ShapeSpec:
     """One shape of a body, placed in the body frame (relative to the frame origin)."""
 
@@ -37,7 +37,7 @@ class ShapeSpec:
     mask: int = 0xFFFFFFFF
 
 
-@dataclass
+@dataclass(slots=True)
 class JointSpec:
     """One joint in body-frame terms (body -1: the world); ``drive`` is mutable (motor speed and the like)."""
 
@@ -53,7 +53,7 @@ class JointSpec:
     to_world: bool = False  # the user's ``b`` was None: the world is body_a (-1) and the user's ``a`` is body_b
 
 
-@dataclass
+@dataclass(slots=True)
 class _BodyRow:
     mass_properties: MassProperties | None  # None: static
     shapes: list[ShapeSpec]
@@ -142,6 +142,18 @@ class ModelBuilder:
         inv_inertia[is_dynamic] = np.linalg.inv(inertia[is_dynamic])  # as mass_row inverts one
         inv_mass = np.divide(1.0, mass, out=np.zeros(n), where=is_dynamic)
         specs = [(i, s) for i, row in enumerate(self.rows) for s in row.shapes]
+        shape_body = np.array([i for i, _ in specs], np.int64)
+        geometry = pack_geometry(
+            [s.shape for _, s in specs],
+            shape_body,
+            np.array([s.position for _, s in specs], np.float64).reshape(-1, 3) - com[shape_body],
+            np.array([s.quat for _, s in specs], np.float64).reshape(-1, 4),
+        )
+        # The radius a shape rolls on (sphere, capsule, cylinder) and the one swept round a sphere's centre or a
+        # capsule's segment: the first of their params; 0 for the other shapes.
+        radius, kind = geometry.shape_params[:, 0], geometry.shape_type
+        rolls = np.isin(kind, (ShapeType.SPHERE, ShapeType.CAPSULE, ShapeType.CYLINDER))
+        swept = np.isin(kind, (ShapeType.SPHERE, ShapeType.CAPSULE))
         joints, joint_exclusions = self._joint_arrays()
         return Model(
             gravity=np.array(gravity, dtype=np.float64),
@@ -154,16 +166,11 @@ class ModelBuilder:
             body_linear_damping=np.array([r.linear_damping for r in self.rows], dtype=np.float64),
             body_angular_damping=np.array([r.angular_damping for r in self.rows], dtype=np.float64),
             body_name=tuple(r.name for r in self.rows),
-            geometry=pack_geometry(
-                [s.shape for _, s in specs],
-                [i for i, _ in specs],
-                np.array([s.position - com[i] for i, s in specs], dtype=np.float64).reshape(-1, 3),
-                np.array([s.quat for _, s in specs], dtype=np.float64).reshape(-1, 4),
-            ),
+            geometry=geometry,
             shape_friction=np.array([s.friction for _, s in specs], dtype=np.float64),
             shape_restitution=np.array([s.restitution for _, s in specs], dtype=np.float64),
-            shape_rolling=np.array([s.rolling_resistance * _rolling_radius(s.shape) for _, s in specs], np.float64),
-            shape_core_radius=np.array([_core_radius(s.shape) for _, s in specs], np.float64),
+            shape_rolling=np.array([s.rolling_resistance for _, s in specs], np.float64) * np.where(rolls, radius, 0.0),
+            shape_core_radius=np.where(swept, radius, 0.0),
             shape_group=np.array([s.group for _, s in specs], dtype=np.uint32),
             shape_mask=np.array([s.mask for _, s in specs], dtype=np.uint32),
             has_contacts=_contacts_possible(specs, is_dynamic),
@@ -194,13 +201,3 @@ def _contacts_possible(specs: list[tuple[int, ShapeSpec]], is_dynamic: np.ndarra
             if (group_a & mask_b) and (group_b & mask_a) and (dynamic_a or dynamic_b) and len(bodies_a | bodies_b) > 1:
                 return True
     return False
-
-
-def _rolling_radius(shape) -> float:
-    """The radius a shape rolls on (sphere, capsule, cylinder); 0 for shapes that do not roll."""
-    return float(getattr(shape, "radius", 0.0)) if isinstance(shape, (Sphere, Capsule, Cylinder)) else 0.0
-
-
-def _core_radius(shape) -> float:
-    """The radius swept round a sphere's centre or a capsule's segment; 0 for the other shapes."""
-    return float(shape.radius) if isinstance(shape, (Sphere, Capsule)) else 0.0

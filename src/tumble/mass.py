@@ -101,21 +101,31 @@ class MassProperties:
     (4.0, [0.0, 0.0, 0.5])
     """
 
-    __slots__ = ("_mass", "_com", "_inertia")
+    __slots__ = ("_mass", "_com", "_inertia", "_moments")
 
     def __init__(self, mass, com, inertia) -> None:
         object.__setattr__(self, "_mass", as_float("mass", mass, positive=True))
         object.__setattr__(self, "_com", _readonly(as_vector3("com", com)))
         object.__setattr__(self, "_inertia", _readonly(_check_inertia(inertia)))
+        object.__setattr__(self, "_moments", None)
 
     @classmethod
-    def _trusted(cls, mass: float, com: np.ndarray, inertia: np.ndarray) -> MassProperties:
-        """One made from a valid one by a change that keeps it valid (a positive scale), without checking again."""
+    def _trusted(cls, mass: float, com: np.ndarray, inertia: np.ndarray, moments=None) -> MassProperties:
+        """One made from a valid one by a change that keeps it valid (a positive scale), without checking again;
+        ``moments``: its principal moments when known."""
         out = object.__new__(cls)
         object.__setattr__(out, "_mass", float(mass))
         object.__setattr__(out, "_com", _readonly(com))
         object.__setattr__(out, "_inertia", _readonly(inertia))
+        object.__setattr__(out, "_moments", moments)
         return out
+
+    def _principal_moments(self) -> np.ndarray:
+        """The principal moments, ascending, worked out once (a body checks them, and bodies of one shape and
+        scale share them)."""
+        if self._moments is None:
+            object.__setattr__(self, "_moments", _readonly(np.linalg.eigvalsh(self._inertia)))
+        return self._moments
 
     def __setattr__(self, name, value):
         raise AttributeError(f"MassProperties is immutable; cannot set {name!r} (build a new one instead)")
@@ -206,7 +216,8 @@ class MassProperties:
     def scaled_to(self, mass) -> MassProperties:
         """The same shape with total mass ``mass`` [kg]: the inertia scales with the mass."""
         new_mass = as_float("mass", mass, positive=True)
-        return MassProperties._trusted(new_mass, self._com, self._inertia * (new_mass / self._mass))
+        scale = new_mass / self._mass
+        return MassProperties._trusted(new_mass, self._com, self._inertia * scale, self._principal_moments() * scale)
 
     # --- composites ----------------------------------------------------------------------------------
 

@@ -63,6 +63,13 @@ def _frozen(values) -> np.ndarray:
     return out
 
 
+def _centred_bounds(shape) -> tuple[np.ndarray, np.ndarray]:
+    """``(-h, h)`` for a primitive centred on its frame, ``h`` from its class's vectorised ``_half_widths`` (which
+    ``geometry.packing`` calls once for all the shapes of a class)."""
+    half = shape._half_widths(shape._params[None])[0]
+    return -half, half
+
+
 def _unit_direction(direction) -> np.ndarray:
     return as_unit_vector3("direction", direction, tiny=0.0)
 
@@ -194,9 +201,12 @@ class Sphere(Shape):
     def mass_properties(self, *, mass=None, density=None) -> _mass.MassProperties:
         return _mass.solid_sphere(self.radius, mass=mass, density=density)
 
+    @staticmethod
+    def _half_widths(params: np.ndarray) -> np.ndarray:
+        return np.repeat(params[:, :1], 3, axis=1)
+
     def local_bounds(self) -> tuple[np.ndarray, np.ndarray]:
-        r = self.radius
-        return np.full(3, -r), np.full(3, r)
+        return _centred_bounds(self)
 
     def support(self, direction) -> np.ndarray:
         return self.radius * _unit_direction(direction)
@@ -230,8 +240,12 @@ class Box(Shape):
     def mass_properties(self, *, mass=None, density=None) -> _mass.MassProperties:
         return _mass.box(self.extents, mass=mass, density=density)
 
+    @staticmethod
+    def _half_widths(params: np.ndarray) -> np.ndarray:
+        return params[:, :3].copy()
+
     def local_bounds(self) -> tuple[np.ndarray, np.ndarray]:
-        return -self.half_extents, self.half_extents
+        return _centred_bounds(self)
 
     def support(self, direction) -> np.ndarray:
         d = _unit_direction(direction)
@@ -270,9 +284,13 @@ class Capsule(Shape):
     def mass_properties(self, *, mass=None, density=None) -> _mass.MassProperties:
         return _mass.capsule(self.radius, self.length, mass=mass, density=density)
 
+    @staticmethod
+    def _half_widths(params: np.ndarray) -> np.ndarray:
+        r, half = params[:, 0], params[:, 1]
+        return np.stack([r, r, half + r], axis=1)
+
     def local_bounds(self) -> tuple[np.ndarray, np.ndarray]:
-        r, half = self._params[0], self._params[1]
-        return np.array([-r, -r, -half - r]), np.array([r, r, half + r])
+        return _centred_bounds(self)
 
     def support(self, direction) -> np.ndarray:
         d = _unit_direction(direction)
@@ -305,9 +323,13 @@ class Cylinder(Shape):
     def mass_properties(self, *, mass=None, density=None) -> _mass.MassProperties:
         return _mass.solid_cylinder(self.radius, self.height, mass=mass, density=density)
 
+    @staticmethod
+    def _half_widths(params: np.ndarray) -> np.ndarray:
+        r, half = params[:, 0], params[:, 1]
+        return np.stack([r, r, half], axis=1)
+
     def local_bounds(self) -> tuple[np.ndarray, np.ndarray]:
-        r, half = self._params[0], self._params[1]
-        return np.array([-r, -r, -half]), np.array([r, r, half])
+        return _centred_bounds(self)
 
     def support(self, direction) -> np.ndarray:
         d = _unit_direction(direction)

@@ -121,7 +121,9 @@ def _body_mass_properties(items: list[ShapeSpec], mass, density, inertia) -> Mas
         return MassProperties(as_float("mass", mass, positive=True), np.zeros(3), inertia)
     kind, value = mass_or_density(mass, density)
     per_volume = value if kind == "density" else 1.0
-    mp = sum(_placed_mass_properties(it, per_volume) for it in items)
+    mp = _placed_mass_properties(items[0], per_volume)
+    for item in items[1:]:
+        mp = mp + _placed_mass_properties(item, per_volume)
     if kind == "mass":
         mp = mp.scaled_to(value)
     if inertia is not None:
@@ -134,7 +136,7 @@ def _placed_mass_properties(item: ShapeSpec, density: float) -> MassProperties:
     bodies, and moving them would only cost time)."""
     shape = item.shape
     mp = shape._unit_mass_properties() if density == 1.0 else shape.mass_properties(density=density)
-    if np.array_equal(item.quat, _IDENTITY) and not item.position.any():
+    if (item.quat == _IDENTITY).all() and not item.position.any():
         return mp
     return mp.transformed(rotation=item.quat, translation=item.position)
 
@@ -158,7 +160,7 @@ def _explicit_mass_properties(mass_properties, mass, density, inertia) -> MassPr
 
 
 def _require_definite(mp: MassProperties) -> None:
-    moments = np.linalg.eigvalsh(mp.inertia)
+    moments = mp._principal_moments()
     if moments[0] <= 1e-12 * moments[-1]:
         raise ValueError(
             f"inertia must be positive definite for a dynamic body, got principal moments {moments.tolist()}"
@@ -209,7 +211,8 @@ class World:
         self._state = State.empty(0)
         self._inputs = Inputs.zeros(0)
         self._scratch = Scratch.for_world(0, 0)
-        self._pending: list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = []
+        # The rows of bodies added since the state last grew: their COM, quat, linvel and angmom, a list each.
+        self._pending: tuple[list[np.ndarray], ...] = ([], [], [], [])
         self._bodies: list[Body] = []
         self._joints: list[Joint] = []
         self._controllers = Controllers()
@@ -422,7 +425,9 @@ class World:
         return name
 
     def _append(self, index, com, quat, velocity, angmom) -> Body:
-        self._pending.append(tuple(np.array(v, np.float64) for v in (com, quat, velocity, angmom)))
+        """The new body's handle; its (3,) and (4,) float64 arrays must be fresh: the world owns them from now."""
+        for column, value in zip(self._pending, (com, quat, velocity, angmom), strict=True):
+            column.append(value)
         self._model = None
         body = Body(self, index)
         self._bodies.append(body)
@@ -435,7 +440,8 @@ class World:
         s = self._state
         if index < s.body_count:
             return s.body_pos[index], s.body_quat[index], s.body_linvel[index], s.body_angmom[index]
-        return self._pending[index - s.body_count]
+        row = index - s.body_count
+        return tuple(column[row] for column in self._pending)
 
     def _mass_row(self, index: int) -> tuple[float, np.ndarray, np.ndarray, np.ndarray]:
         """``(mass, com, inertia, inv_inertia)`` of one body, body frame: the model's row when it is built, else the
@@ -448,14 +454,15 @@ class World:
     def _grow(self) -> None:
         """Append the state and input rows of the bodies added since, and zero impulses for the joints added since;
         the model is left as it is."""
-        if self._pending:
-            self._state = self._state.grown(*(np.array(column) for column in zip(*self._pending, strict=True)))
-            added = Inputs.zeros(len(self._pending))
+        if self._pending[0]:
+            self._state = self._state.grown(*(np.array(column) for column in self._pending))
+            added = Inputs.zeros(len(self._pending[0]))
             self._inputs = Inputs(
                 np.concatenate([self._inputs.body_force, added.body_force]),
                 np.concatenate([self._inputs.body_torque, added.body_torque]),
             )
-            self._pending.clear()
+            for column in self._pending:
+                column.clear()
         self._state.with_joints(len(self._builder.joints))
 
     def _sync(self) -> None:

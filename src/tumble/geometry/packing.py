@@ -108,6 +108,24 @@ def _boundary_loop(triangles: np.ndarray) -> np.ndarray:
     return np.array(loop, dtype=np.int64)
 
 
+def _local_bounds(shapes: list[Shape]) -> tuple[np.ndarray, np.ndarray]:
+    """``(lo, hi)``, each (n, 3): every shape's ``local_bounds``, those of the primitives worked out by class in one
+    vectorised call (a world of 100 000 boxes would otherwise make 100 000 calls)."""
+    n = len(shapes)
+    lo, hi = np.zeros((n, 3)), np.zeros((n, 3))
+    by_class: dict[type, list[int]] = {}
+    for k, shape in enumerate(shapes):
+        by_class.setdefault(type(shape), []).append(k)
+    for cls, rows in by_class.items():
+        if hasattr(cls, "_half_widths"):
+            half = cls._half_widths(np.array([shapes[k].params for k in rows], np.float64).reshape(-1, 4))
+            lo[rows], hi[rows] = -half, half
+        else:
+            for k in rows:
+                lo[k], hi[k] = shapes[k].local_bounds()
+    return lo, hi
+
+
 def pack_geometry(shapes: list[Shape], shape_body, pos_local: np.ndarray, quat_local: np.ndarray) -> GeometryArrays:
     """Pack shapes placed in their bodies (``pos_local`` relative to the body COM) into :class:`GeometryArrays`.
 
@@ -157,10 +175,10 @@ def pack_geometry(shapes: list[Shape], shape_body, pos_local: np.ndarray, quat_l
         v_total += len(vertices)
         f_count[k], e_count[k] = len(loops) - f_start[k], len(edges) - e_start[k]
     # Bounds in the body frame: each shape's local box turned by its local rotation (centre R c, half-widths |R| h).
+    lo, hi = _local_bounds(shapes)
     # A plane is unbounded: its box is centred on its origin, infinite.
     bounded = np.array([shape.type != ShapeType.PLANE for shape in shapes], bool).reshape(n)
-    bounds = np.array([np.concatenate(s.local_bounds()) for s, b in zip(shapes, bounded, strict=True) if b], np.float64)
-    lo, hi = bounds.reshape(-1, 6)[:, :3], bounds.reshape(-1, 6)[:, 3:]
+    lo, hi = lo[bounded], hi[bounded]
     centers, halves = pos_local.copy(), np.full((n, 3), np.inf)
     centers[bounded] += quat_rotate(quat_local[bounded], 0.5 * (lo + hi))
     halves[bounded] = np.einsum("nij,nj->ni", np.abs(quat_to_matrix(quat_local[bounded])), 0.5 * (hi - lo))

@@ -16,6 +16,7 @@ from __future__ import annotations
 import json
 import tomllib
 from dataclasses import dataclass
+from functools import cached_property
 from pathlib import Path
 
 from pydantic import ValidationError
@@ -41,11 +42,18 @@ class RunSettings:
 
 @dataclass(frozen=True)
 class LoadedScene:
-    """A loaded scene: the world built, the run settings, and the validated scene as a JSON-able dict."""
+    """A loaded scene: the world built, the run settings, and the validated scene (``source``: as a JSON-able dict,
+    every key with its default filled in)."""
 
     world: object
     run: RunSettings
-    source: dict
+    scene: schema.Scene
+
+    @cached_property
+    def source(self) -> dict:
+        # Made when first asked for (tumble run stores it with the recording): for a scene of 100 000 bodies it
+        # costs a tenth of the load.
+        return self.scene.model_dump(mode="json", exclude_none=True)
 
 
 def _place(location: tuple) -> str:
@@ -89,7 +97,7 @@ def from_dict(data: dict, *, base: Path | str = ".", label: str = "<scene>") -> 
         raise SceneError(_validation_message(label, error)) from None
     world = build_world(scene, Path(base), label)
     run = RunSettings(scene.world.dt, scene.world.duration, scene.recording.every, scene.recording.path)
-    return LoadedScene(world, run, scene.model_dump(mode="json", exclude_none=True))
+    return LoadedScene(world, run, scene)
 
 
 def load(path) -> LoadedScene:

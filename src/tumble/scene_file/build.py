@@ -58,15 +58,31 @@ def _shape(shape, base: Path, place: str, label: str):
     return _mesh(shape, base, place, label)
 
 
-def _geometry(item: schema._Placed, base: Path, place: str, label: str):
-    if item.shape is not None:
-        return _shape(item.shape, base, f"{place}.shape", label)
-    if item.shapes is not None:
-        return [
-            (_shape(part.shape, base, f"{place}.shapes[{k}].shape", label), part.position, part.orientation)
-            for k, part in enumerate(item.shapes)
-        ]
-    return None
+class _Shapes:
+    """The scene's shapes, one object for each distinct description: the bodies of a pile share their shape, so a
+    mesh file is read once and a hull packed once, however many bodies use it."""
+
+    def __init__(self, base: Path, label: str) -> None:
+        self.base, self.label = base, label
+        self._made: dict = {}
+
+    def __call__(self, shape, place: str):
+        key = (type(shape), shape)  # the shape models are frozen: equal descriptions hash alike
+        try:
+            hash(key)
+        except TypeError:  # a hull's or a mesh's lists of points
+            key = (type(shape), shape.model_dump_json())
+        if key not in self._made:
+            self._made[key] = _shape(shape, self.base, place, self.label)
+        return self._made[key]
+
+    def geometry(self, item: schema._Placed, place: str):
+        if item.shape is not None:
+            return self(item.shape, f"{place}.shape")
+        if item.shapes is not None:
+            return [(self(part.shape, f"{place}.shapes[{k}].shape"), part.position, part.orientation)
+                    for k, part in enumerate(item.shapes)]  # fmt: skip
+        return None
 
 
 def _material(item: schema._Placed, materials: dict[str | None, dict], place: str, label: str) -> dict:
@@ -153,6 +169,7 @@ def build_world(scene: schema.Scene, base: Path, label: str) -> World:
                                           "joint_damping_ratio", "sleep"}, exclude_none=True)  # fmt: skip
     world = World(settings.gravity, integrator=settings.integrator, **solver)
     named: dict = {}
+    shapes = _Shapes(base, label)
     materials = {None: schema.Material().model_dump()} | {k: m.model_dump() for k, m in scene.materials.items()}
     for kind, items in (("bodies", scene.bodies), ("vehicles", scene.vehicles), ("static", scene.static)):
         if kind == "vehicles":  # after the bodies, before the static geometry: the order to_scene writes them in
@@ -161,7 +178,7 @@ def build_world(scene: schema.Scene, base: Path, label: str) -> World:
         for k, item in enumerate(items):
             place = f"{kind}[{k}]"
             try:
-                geometry = _geometry(item, base, place, label)
+                geometry = shapes.geometry(item, place)
                 common = {
                     "name": item.name,
                     "position": item.position,
@@ -178,8 +195,10 @@ def build_world(scene: schema.Scene, base: Path, label: str) -> World:
                                           velocity=item.velocity, angular_velocity=item.angular_velocity,
                                           linear_damping=item.linear_damping, angular_damping=item.angular_damping,
                                           **common)  # fmt: skip
-                    body.constant_force = item.constant_force
-                    body.constant_torque = item.constant_torque
+                    if any(item.constant_force):  # zero unless set
+                        body.constant_force = item.constant_force
+                    if any(item.constant_torque):
+                        body.constant_torque = item.constant_torque
                 else:
                     body = world.add_static(geometry, **common)
             except SceneError:
