@@ -104,8 +104,9 @@ class ModelBuilder:
         angular_damping: float = 0.0,
         name: str | None = None,
     ) -> int:
-        """Append a body (``mass_properties=None`` for a static one); returns its row."""
-        self.rows.append(_BodyRow(mass_properties, list(shapes), linear_damping, angular_damping, name))
+        """Append a body (``mass_properties=None`` for a static one); returns its row. ``shapes`` is kept, not
+        copied: the caller hands over a list of its own."""
+        self.rows.append(_BodyRow(mass_properties, shapes, linear_damping, angular_damping, name))
         if name is not None:
             self._names[name] = len(self.rows) - 1
         return len(self.rows) - 1

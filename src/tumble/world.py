@@ -39,6 +39,12 @@ from .wind import Constant, Wind, as_wind
 __all__ = ["World"]
 
 _IDENTITY = np.array([1.0, 0.0, 0.0, 0.0])
+# add_body's defaults: an argument left at one of them skips its validation (bodies are added by the 100 000).
+_ORIGIN, _NO_ROTATION = (0.0, 0.0, 0.0), (1.0, 0.0, 0.0, 0.0)
+
+
+def _vector_or_origin(name: str, value) -> np.ndarray:
+    return np.zeros(3) if value is _ORIGIN else as_vector3(name, value)
 
 
 def _check_integrator(integrator) -> str:
@@ -242,10 +248,10 @@ class World:
         mass=None,
         density=None,
         inertia=None,
-        position=(0.0, 0.0, 0.0),
-        orientation=(1.0, 0.0, 0.0, 0.0),
-        velocity=(0.0, 0.0, 0.0),
-        angular_velocity=(0.0, 0.0, 0.0),
+        position=_ORIGIN,
+        orientation=_NO_ROTATION,
+        velocity=_ORIGIN,
+        angular_velocity=_ORIGIN,
         friction: float = 0.5,
         restitution: float = 0.0,
         rolling_resistance: float = 0.0,
@@ -267,10 +273,10 @@ class World:
         of the body's shapes; see ``docs/contact.md``. ``mass_properties`` (a :class:`~tumble.MassProperties` in
         the body frame) gives mass, centre of mass and inertia at once, in place of ``mass``/``density``/``inertia``.
         """
-        position = as_vector3("position", position)
-        quat = as_quaternion("orientation", orientation)
-        velocity = as_vector3("velocity", velocity)
-        angular_velocity = as_vector3("angular_velocity", angular_velocity)
+        position = _vector_or_origin("position", position)
+        quat = _IDENTITY.copy() if orientation is _NO_ROTATION else as_quaternion("orientation", orientation)
+        velocity = _vector_or_origin("velocity", velocity)
+        angular_velocity = _vector_or_origin("angular_velocity", angular_velocity)
         material = self._check_material(friction, restitution, rolling_resistance)
         linear_damping = as_float("linear_damping", linear_damping, nonnegative=True)
         angular_damping = as_float("angular_damping", angular_damping, nonnegative=True)
