@@ -188,3 +188,21 @@ def test_a_name_index_answers_for_a_loaded_checkpoint(tmp_path):
         loaded.add_body(tumble.Sphere(0.1), mass=1.0, name="box3")
     with pytest.raises(KeyError, match="no body named 'nope'"):
         loaded.body("nope")
+
+
+def test_loading_a_scene_leaves_the_cyclic_collector_as_it_found_it(tmp_path):
+    import gc
+
+    path = tmp_path / "chain.toml"
+    path.write_text(_scene_text(5))
+    bad = tmp_path / "bad.toml"
+    bad.write_text(_scene_text(5).replace("mass = 1.0", "mass = -1.0", 1))
+    for enabled in (True, False):
+        gc.enable() if enabled else gc.disable()
+        try:
+            scene_file.load(path)
+            with pytest.raises(scene_file.SceneError, match=r"bodies\[0\]\.mass"):
+                scene_file.load(bad)
+            assert gc.isenabled() == enabled
+        finally:
+            gc.enable()

@@ -247,3 +247,21 @@ def test_joint_aliases_build_ropes_and_springs(tmp_path):
     rope, spring = (world._builder.joints[j.index].drive for j in world.joints)
     assert rope[0] == 0.0 and rope[1] == 1.0  # slack down to 0, taut at its length
     assert spring[4] == 2.0 and spring[6] == 1.0  # a spring towards the length at creation
+
+
+def test_the_fast_toml_parser_reads_every_shipped_scene_as_the_standard_one_does(monkeypatch):
+    import sys
+    import tomllib
+
+    from tumble.scene_file import _parse_toml
+
+    for path in scene_file.shipped():
+        text = path.read_text()
+        assert _parse_toml(text) == tomllib.loads(text), path.name
+    # Without rtoml the standard parser reads them, and a malformed file is reported as it reports it either way.
+    text = scene_file.shipped_scene("pendulum").read_text()
+    monkeypatch.setitem(sys.modules, "rtoml", None)
+    assert _parse_toml(text) == tomllib.loads(text)
+    monkeypatch.delitem(sys.modules, "rtoml")
+    with pytest.raises(tomllib.TOMLDecodeError, match=r"Cannot overwrite a value \(at line 3"):
+        _parse_toml("[world]\na = 1\na = 2\n")
