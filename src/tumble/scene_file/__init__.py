@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import gc
 import json
+import reprlib
 import tomllib
 from contextlib import contextmanager
 from dataclasses import dataclass
@@ -64,7 +65,11 @@ def _place(location: tuple) -> str:
     for part in location:
         if isinstance(part, int):
             text += f"[{part}]"
-        elif part in _UNION_TAGS or part == "QuadrotorParams" or part.startswith(("tuple[", "function-", "literal[")):
+        elif (
+            part in _UNION_TAGS
+            or part in ("QuadrotorParams", "float", "int")
+            or part.startswith(("tuple[", "function-", "literal["))
+        ):
             continue
         else:
             text += f".{part}" if text else part
@@ -83,7 +88,11 @@ def _validation_message(label: str, error: ValidationError) -> str:
         if item["type"] == "extra_forbidden":
             message = "unknown key"
         got = item.get("input")
-        shown = repr(got) if len(repr(got)) <= 60 else repr(got)[:57] + "..."
+        try:
+            shown = repr(got)
+        except RecursionError:  # nested thousands deep: the first levels
+            shown = reprlib.repr(got)
+        shown = shown if len(shown) <= 60 else shown[:57] + "..."
         lines.append(f"{label}: {_place(item['loc'])}: {message} (got {shown})")
     more = error.error_count() - len(lines)
     return "\n".join(lines) + (f"\n{label}: ... and {more} more" if more > 0 else "")
@@ -123,6 +132,8 @@ def from_dict(data: dict, *, base: Path | str = ".", label: str = "<scene>") -> 
             scene = schema.Scene.model_validate(data)
         except ValidationError as error:
             raise SceneError(_validation_message(label, error)) from None
+        except RecursionError:  # a dict nested thousands deep
+            raise SceneError(f"{label}: nested too deeply to be a scene") from None
         world = build_world(scene, Path(base), label)
     run = RunSettings(scene.world.dt, scene.world.duration, scene.recording.every, scene.recording.path)
     return LoadedScene(world, run, scene)
@@ -135,14 +146,20 @@ def load(path) -> LoadedScene:
     if path.suffix not in (".toml", ".json"):
         raise SceneError(f"{label}: a scene file must end in .toml or .json")
     try:
-        text = path.read_text(encoding="utf-8")
+        text = path.read_bytes().decode("utf-8-sig")  # a byte-order mark, as some editors write, is skipped
     except OSError as error:
         raise SceneError(f"{label}: cannot read the file: {error.strerror or error}") from None
+    except UnicodeDecodeError as error:
+        byte = error.object[error.start]
+        raise SceneError(f"{label}: not UTF-8 text (byte 0x{byte:02x} at offset {error.start}: {error.reason}); "
+                         "scene files are UTF-8") from None  # fmt: skip
     with _without_cyclic_gc():
         try:
             data = _parse_toml(text) if path.suffix == ".toml" else json.loads(text)
         except (tomllib.TOMLDecodeError, json.JSONDecodeError) as error:
             raise SceneError(f"{label}: not valid {path.suffix[1:].upper()}: {error}") from None
+        except RecursionError:
+            raise SceneError(f"{label}: not valid {path.suffix[1:].upper()}: nested too deeply") from None
         return from_dict(data, base=path.parent, label=label)
 
 

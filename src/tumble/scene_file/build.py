@@ -167,7 +167,10 @@ def build_world(scene: schema.Scene, base: Path, label: str) -> World:
     settings = scene.world
     solver = settings.model_dump(include={"substeps", "contact_hertz", "contact_damping_ratio", "joint_hertz",
                                           "joint_damping_ratio", "sleep"}, exclude_none=True)  # fmt: skip
-    world = World(settings.gravity, integrator=settings.integrator, **solver)
+    try:
+        world = World(settings.gravity, integrator=settings.integrator, **solver)
+    except (ValueError, TypeError) as error:
+        raise SceneError(f"{label}: world: {error}") from None
     named: dict = {}
     shapes = _Shapes(base, label)
     materials = {None: schema.Material().model_dump()} | {k: m.model_dump() for k, m in scene.materials.items()}

@@ -9,14 +9,17 @@ from __future__ import annotations
 import math
 from typing import Annotated, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
+from pydantic import BaseModel, ConfigDict, Field, Strict, StrictBool, field_validator, model_validator
 
-Vector3 = tuple[float, float, float]
-Quaternion = tuple[float, float, float, float]
-Positive = Annotated[float, Field(gt=0.0, allow_inf_nan=False)]
-NonNegative = Annotated[float, Field(ge=0.0, allow_inf_nan=False)]
-Finite = Annotated[float, Field(allow_inf_nan=False)]
-Bits = Annotated[int, Field(ge=0, le=0xFFFFFFFF)]
+# Numbers are strict: an integer or a float, never a boolean (``radius = true`` is not 1) nor a string; and finite
+# unless said otherwise.
+Finite = Annotated[float, Strict(), Field(allow_inf_nan=False)]
+Positive = Annotated[float, Strict(), Field(gt=0.0, allow_inf_nan=False)]
+NonNegative = Annotated[float, Strict(), Field(ge=0.0, allow_inf_nan=False)]
+Vector3 = tuple[Finite, Finite, Finite]
+Quaternion = tuple[Finite, Finite, Finite, Finite]
+Integer = Annotated[int, Strict()]
+Bits = Annotated[int, Strict(), Field(ge=0, le=0xFFFFFFFF)]
 
 
 class _Strict(BaseModel):
@@ -66,7 +69,7 @@ class MeshShape(_Strict):
     type: Literal["mesh"]
     path: str | None = None
     vertices: list[Vector3] | None = None
-    faces: list[tuple[int, int, int]] | None = None
+    faces: list[tuple[Integer, Integer, Integer]] | None = None
 
     @model_validator(mode="after")
     def _one_source(self):
@@ -96,7 +99,7 @@ class Part(_Strict):
 
 class Material(_Strict):
     friction: NonNegative = 0.5
-    restitution: Annotated[float, Field(ge=0.0, le=1.0)] = 0.0
+    restitution: Annotated[float, Strict(), Field(ge=0.0, le=1.0)] = 0.0
     rolling_resistance: NonNegative = 0.0
 
 
@@ -108,7 +111,7 @@ class _Placed(_Strict):
     orientation: Quaternion = (1.0, 0.0, 0.0, 0.0)
     material: str | None = None
     friction: NonNegative | None = None
-    restitution: Annotated[float, Field(ge=0.0, le=1.0)] | None = None
+    restitution: Annotated[float, Strict(), Field(ge=0.0, le=1.0)] | None = None
     rolling_resistance: NonNegative | None = None
     collision_group: Bits = 1
     collision_mask: Bits = 0xFFFFFFFF
@@ -158,7 +161,7 @@ class Static(_Placed):
 class _Joint(_Strict):
     a: str = Field(min_length=1)
     b: str | None = None  # None or "world": the world
-    collide_connected: bool = False
+    collide_connected: StrictBool = False
 
     @field_validator("b")
     @classmethod
@@ -170,9 +173,9 @@ class BallJoint(_Joint):
     type: Literal["ball"]
     anchor: Vector3
     axis: Vector3 | None = None
-    cone_angle: Annotated[float, Field(gt=0.0, le=math.pi)] | None = None
-    twist_lower: Annotated[float, Field(ge=-math.pi, le=math.pi)] | None = None
-    twist_upper: Annotated[float, Field(ge=-math.pi, le=math.pi)] | None = None
+    cone_angle: Annotated[float, Strict(), Field(gt=0.0, le=math.pi)] | None = None
+    twist_lower: Annotated[float, Strict(), Field(ge=-math.pi, le=math.pi)] | None = None
+    twist_upper: Annotated[float, Strict(), Field(ge=-math.pi, le=math.pi)] | None = None
 
 
 class _Drive(_Joint):
@@ -295,7 +298,7 @@ class SE3ControllerSpec(_Strict):
     kp_att: Finite | None = None
     kd_att: Finite | None = None
     integral_limit: Finite | None = None
-    feedforward: bool = False
+    feedforward: StrictBool = False
 
 
 class CascadedPIDSpec(_Strict):
@@ -391,7 +394,7 @@ class DrydenWind(_Strict):
     mean: Vector3
     sigma: Gain
     length_scale: Gain
-    seed: Annotated[int, Field(ge=0)] | None = None
+    seed: Annotated[int, Strict(), Field(ge=0)] | None = None
 
 
 Wind = Annotated[ConstantWind | SinusoidWind | DrydenWind, Field(discriminator="type")]
@@ -405,16 +408,16 @@ class WorldSettings(_Strict):
     dt: Positive = 1.0 / 60.0
     duration: Positive = 5.0
     integrator: Literal["auto", "euler", "symplectic", "rk4", "midpoint"] = "auto"
-    substeps: Annotated[int, Field(ge=1, le=1000)] | None = None
+    substeps: Annotated[int, Strict(), Field(ge=1, le=1000)] | None = None
     contact_hertz: Positive | None = None
     contact_damping_ratio: NonNegative | None = None
-    joint_hertz: Annotated[float, Field(gt=0.0)] | None = None  # inf: as stiff as the substeps allow
+    joint_hertz: Annotated[float, Strict(), Field(gt=0.0)] | None = None  # inf: as stiff as the substeps allow
     joint_damping_ratio: NonNegative | None = None
-    sleep: bool | None = None
+    sleep: StrictBool | None = None
 
 
 class Recording(_Strict):
-    every: Annotated[int, Field(ge=1)] = 1
+    every: Annotated[int, Strict(), Field(ge=1, le=2**31 - 1)] = 1
     path: str | None = None
 
 

@@ -1,0 +1,97 @@
+"""Bad scene files give a located message and exit status 2, never a traceback (issue 21, the cases done so far):
+strict numbers, finite vectors, any bytes and any depth. The CLI runs in-process, as ``tumble info`` would."""
+
+from __future__ import annotations
+
+import pytest
+
+from tumble import scene_file
+from tumble.cli import EXIT_BAD_INPUT, main
+
+GOOD = """[world]
+gravity = [0, 0, -9.81]
+
+[[bodies]]
+name = "ball"
+shape = { type = "sphere", radius = 0.5 }
+mass = 1.0
+position = [0, 0, 1]
+
+[recording]
+every = 1
+"""
+
+
+def _fails_cleanly(capsys, path, *expected: str) -> str:
+    status = main(["info", str(path)])
+    out, err = capsys.readouterr()
+    assert status == EXIT_BAD_INPUT, (status, out, err)
+    assert "Traceback" not in out + err
+    for text in expected:
+        assert text in err, (text, err)
+    return err
+
+
+@pytest.mark.parametrize(
+    ("old", "new", "expected"),
+    [
+        ("radius = 0.5", "radius = true", "bodies[0].shape.radius: Input should be a valid number (got True)"),
+        ("mass = 1.0", 'mass = "1"', "bodies[0].mass: Input should be a valid number (got '1')"),
+        ("gravity = [0, 0, -9.81]", "gravity = [nan, 0, -9.81]", "world.gravity[0]: Input should be a finite number"),
+        ("gravity = [0, 0, -9.81]", "gravity = [0, 0, -inf]", "world.gravity[2]: Input should be a finite number"),
+        ("position = [0, 0, 1]", "position = [0, false, 1]", "bodies[0].position[1]: Input should be a valid number"),
+        ("every = 1", "every = 99999999999999999999", "recording.every: Input should be less than or equal to"),
+        ("every = 1", "every = 2.0", "recording.every: Input should be a valid integer"),
+        ("[recording]", "[recording]\npath = 'a.h5'\n[world.x]", "world.x: unknown key"),
+        ("radius = 0.5", "radius = 1e200", "bodies[0]: Sphere(radius=1e+200) is too large: its volume overflows"),
+        ("mass = 1.0", "mass = 1e-320", "bodies[0]: mass=1e-320 is too small for a dynamic body: 1/mass overflows"),
+        ('shape = { type = "sphere", radius = 0.5 }', 'shape = { type = "capsule", radius = 1e103, length = 1 }',
+         "bodies[0]: Capsule(radius=1e+103"),
+    ],
+)  # fmt: skip
+def test_a_bad_value_is_named_with_its_place(capsys, tmp_path, old, new, expected):
+    assert old in GOOD
+    path = tmp_path / "bad.toml"
+    path.write_text(GOOD.replace(old, new, 1))
+    _fails_cleanly(capsys, path, f"bad.toml: {expected}")
+
+
+def test_the_good_scene_loads(tmp_path):
+    path = tmp_path / "good.toml"
+    path.write_text(GOOD)
+    assert scene_file.load(path).world.bodies[0].name == "ball"
+
+
+@pytest.mark.parametrize(
+    ("name", "data", "expected"),
+    [
+        ("utf16.toml", GOOD.encode("utf-16"), "not UTF-8 text (byte 0xff at offset 0"),
+        ("latin1.toml", ("# café\n" + GOOD).encode("latin-1"), "not UTF-8 text (byte 0xe9 at offset 5"),
+        ("binary.toml", bytes(range(256)), "not UTF-8 text (byte 0x80 at offset 128"),
+        ("binary.json", bytes(range(255, -1, -1)), "not UTF-8 text (byte 0xff at offset 0"),
+        ("deep.toml", ("a = " + "[" * 100_000 + "]" * 100_000 + "\n").encode(), "not valid TOML: nested too deeply"),
+        ("deep.json", ('{"a": ' + "[" * 100_000 + "]" * 100_000 + "}").encode(), "not valid JSON: nested too deeply"),
+        ("nul.toml", b"[world]\x00\n", "not valid TOML"),
+        ("empty.json", b"", "not valid JSON"),
+    ],
+)
+def test_any_bytes_at_any_depth_give_a_located_error(capsys, tmp_path, name, data, expected):
+    path = tmp_path / name
+    path.write_bytes(data)
+    _fails_cleanly(capsys, path, f"{name}: {expected}")
+
+
+def test_a_byte_order_mark_is_skipped(tmp_path):
+    path = tmp_path / "bom.toml"
+    path.write_bytes(b"\xef\xbb\xbf" + GOOD.encode())
+    assert scene_file.load(path).world.bodies[0].name == "ball"
+
+
+def test_a_dict_nested_thousands_deep_is_refused_with_its_first_levels_shown():
+    nested: dict = {}
+    inner = nested
+    for _ in range(5000):
+        inner["a"] = {}
+        inner = inner["a"]
+    with pytest.raises(scene_file.SceneError, match=r"^s: description: Input should be a valid string \(got \{'a': "):
+        scene_file.from_dict({"description": nested}, label="s")
