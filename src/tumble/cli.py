@@ -38,6 +38,8 @@ EXIT_OK = 0
 EXIT_SIMULATION = 1
 EXIT_BAD_INPUT = 2
 EXIT_INTERRUPTED = 130
+MAX_STEPS = 1e15  # steps in one run: more would not end, and their count must stay an exact integer
+MAX_COUNT = 2**31 - 1  # --every, --max-frames: what the kernels hold as an index (scene files: recording.every)
 
 TRAJECTORY_SUFFIXES = (".h5", ".hdf5", ".he5", ".npz")
 PLOT_KINDS = ("energy", "momentum", "omega", "paths", "flight")
@@ -111,8 +113,8 @@ def _positive_int(text: str) -> int:
         value = int(text)
     except ValueError:
         raise argparse.ArgumentTypeError(f"must be an integer, got {text!r}") from None
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"must be an integer >= 1, got {text!r}")
+    if not 1 <= value <= MAX_COUNT:
+        raise argparse.ArgumentTypeError(f"must be an integer from 1 to {MAX_COUNT}, got {text!r}")
     return value
 
 
@@ -193,13 +195,23 @@ def _plot_formats() -> set[str]:
 
 
 def _prepare_output(path: Path) -> Path:
-    """Create the parent directory of an output file; a directory in its place is bad input."""
+    """Create the parent directory of an output file and make sure the file can be written, before anything runs
+    (a run of ten minutes must not fail at its end); a directory in its place is bad input. An existing file is
+    left as it is, a new one removed again."""
     if path.is_dir():
         raise BadInput(f"{path}: is a directory, not a file")
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
     except OSError as error:
         raise BadInput(f"{path}: cannot create its directory: {error.strerror or error}") from None
+    existed = path.exists()
+    try:
+        with open(path, "ab"):
+            pass
+    except OSError as error:
+        raise BadInput(f"{path}: cannot write it: {error.strerror or error}") from None
+    if not existed:
+        path.unlink(missing_ok=True)
     return path
 
 
@@ -301,6 +313,9 @@ def _cmd_run(args) -> int:
     dt = args.dt if args.dt is not None else float(settings.dt)
     duration = args.duration if args.duration is not None else float(settings.duration)
     every = args.every if args.every is not None else int(settings.record_every)
+    if not duration / dt <= MAX_STEPS:
+        raise BadInput(f"--duration {duration:g} at --dt {dt:g} is {duration / dt:g} steps; a run takes at most "
+                       f"{MAX_STEPS:.0e}")  # fmt: skip
     steps = round(duration / dt)
     if steps < 1:
         raise BadInput(f"--duration {duration:g} is shorter than one step of --dt {dt:g}")
@@ -865,6 +880,10 @@ def main(argv: list[str] | None = None) -> int:
         return EXIT_OK
     except _PipeClosed:
         return EXIT_OK
+    except OSError as error:  # a file that could not be written after all (a full disk, a file system gone)
+        where = f"{error.filename}: " if error.filename else ""
+        _error(f"{where}cannot write it: {error.strerror or error}")
+        return EXIT_BAD_INPUT
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -435,6 +435,8 @@ class World:
             return None
         if not isinstance(name, str) or not name:
             raise TypeError(f"name must be a non-empty string or None, got {name!r}")
+        if "\x00" in name:
+            raise ValueError(f"name must not hold a NUL character (HDF5 strings end there), got {name!r}")
         if self._builder.index_of(name) is not None:
             raise ValueError(f"name must be unique in the world, {name!r} is already taken")
         return name

@@ -95,3 +95,83 @@ def test_a_dict_nested_thousands_deep_is_refused_with_its_first_levels_shown():
         inner = inner["a"]
     with pytest.raises(scene_file.SceneError, match=r"^s: description: Input should be a valid string \(got \{'a': "):
         scene_file.from_dict({"description": nested}, label="s")
+
+
+CONTACT = GOOD + '\n[[static]]\nshape = { type = "plane" }\n'
+
+
+def _status(capsys, *argv: str) -> tuple[int, str]:
+    try:
+        status = main(list(argv))
+    except SystemExit as exit_:  # argparse's own refusals
+        status = exit_.code
+    out, err = capsys.readouterr()
+    assert "Traceback" not in out + err
+    return status, err
+
+
+@pytest.mark.parametrize("integrator", ["rk4", "euler", "midpoint"])
+def test_an_integrator_for_free_bodies_only_is_refused_for_a_scene_with_contacts(capsys, tmp_path, integrator):
+    path = tmp_path / "rk4.toml"
+    path.write_text(CONTACT.replace("[world]", f'[world]\nintegrator = "{integrator}"'))
+    for command in ("info", "run"):
+        status, err = _status(capsys, command, str(path))
+        assert status == EXIT_BAD_INPUT
+        assert f"rk4.toml: world.integrator: '{integrator}' integrates free bodies only" in err
+    for fine in ("auto", "symplectic"):
+        path.write_text(CONTACT.replace("[world]", f'[world]\nintegrator = "{fine}"'))
+        assert scene_file.load(path).world.integrator == fine
+
+
+@pytest.mark.parametrize(
+    ("options", "expected"),
+    [
+        (["--dt", "1e-300", "--duration", "1e300"], "--duration 1e+300 at --dt 1e-300 is inf steps"),
+        (["--dt", "1e-10", "--duration", "1e6"], "is 1e+16 steps; a run takes at most 1e+15"),
+        (["--every", "99999999999999999999"], "argument --every: must be an integer from 1 to 2147483647"),
+        (["--out", "/proc/tumble-test.h5"], "/proc/tumble-test.h5: cannot write it:"),
+        (["--html", "/proc/tumble-test.html"], "/proc/tumble-test.html: cannot write it:"),
+        (["--plot", "/proc/tumble-test.png"], "/proc/tumble-test.png: cannot write it:"),
+    ],
+)
+def test_run_options_that_cannot_run_or_be_written_are_refused_before_the_run(capsys, tmp_path, options, expected):
+    path = tmp_path / "good.toml"
+    path.write_text(GOOD)
+    status, err = _status(capsys, "run", str(path), "--duration", "0.05", "-q", *options)
+    assert status == EXIT_BAD_INPUT and expected in err, err
+    assert "simulated" not in err  # nothing ran
+
+
+def test_a_write_that_fails_after_the_run_names_the_path(capsys, tmp_path, monkeypatch):
+    from tumble import viewer
+
+    def full_disk(*args, **kwargs):
+        raise OSError(28, "No space left on device", str(tmp_path / "replay.html"))
+
+    monkeypatch.setattr(viewer, "write_html", full_disk)
+    path = tmp_path / "good.toml"
+    path.write_text(GOOD)
+    status, err = _status(capsys, "run", str(path), "--duration", "0.05", "-q", "--html", str(tmp_path / "replay.html"))
+    assert status == EXIT_BAD_INPUT
+    assert "replay.html: cannot write it: No space left on device" in err
+
+
+@pytest.mark.parametrize(
+    ("old", "new", "expected"),
+    [
+        ('name = "ball"', 'name = "ba\\u0000ll"', "bodies[0].name: Value error, must not hold a NUL character"),
+        ("every = 1", 'every = 1\npath = "out\\u0000.h5"', "recording.path: Value error, must not hold a NUL"),
+    ],
+)
+def test_names_and_paths_with_a_nul_are_refused(capsys, tmp_path, old, new, expected):
+    path = tmp_path / "nul.toml"
+    path.write_text(GOOD.replace(old, new, 1))
+    status, err = _status(capsys, "run", str(path), "--duration", "0.05", "-q")
+    assert status == EXIT_BAD_INPUT and f"nul.toml: {expected}" in err, err
+
+
+def test_the_api_refuses_a_body_name_with_a_nul():
+    import tumble
+
+    with pytest.raises(ValueError, match=r"name must not hold a NUL character .* got 'a\\x00b'"):
+        tumble.World().add_body(tumble.Sphere(0.1), mass=1.0, name="a\x00b")

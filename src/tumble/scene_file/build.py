@@ -231,4 +231,10 @@ def build_world(scene: schema.Scene, base: Path, label: str) -> World:
             raise
         except (ValueError, TypeError) as error:
             raise SceneError(f"{label}: {place}: {error}") from error
+    if settings.integrator not in ("auto", "symplectic") and world.model.has_constraints:
+        raise SceneError(
+            f"{label}: world.integrator: {settings.integrator!r} integrates free bodies only, and this scene's shapes "
+            "can touch or its bodies are jointed (the contact and joint solver steps those): use 'auto' or "
+            "'symplectic'"
+        )
     return world

@@ -9,7 +9,16 @@ from __future__ import annotations
 import math
 from typing import Annotated, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, Strict, StrictBool, field_validator, model_validator
+from pydantic import (
+    AfterValidator,
+    BaseModel,
+    ConfigDict,
+    Field,
+    Strict,
+    StrictBool,
+    field_validator,
+    model_validator,
+)
 
 # Numbers are strict: an integer or a float, never a boolean (``radius = true`` is not 1) nor a string; and finite
 # unless said otherwise.
@@ -19,6 +28,17 @@ NonNegative = Annotated[float, Strict(), Field(ge=0.0, allow_inf_nan=False)]
 Vector3 = tuple[Finite, Finite, Finite]
 Quaternion = tuple[Finite, Finite, Finite, Finite]
 Integer = Annotated[int, Strict()]
+
+
+def _without_nul(text: str) -> str:
+    if "\x00" in text:
+        raise ValueError("must not hold a NUL character (\\x00): HDF5 strings and file names end there")
+    return text
+
+
+# A name goes into every output format, a path to the operating system.
+Name = Annotated[str, Field(min_length=1), AfterValidator(_without_nul)]
+Path = Annotated[str, Field(min_length=1), AfterValidator(_without_nul)]
 Bits = Annotated[int, Strict(), Field(ge=0, le=0xFFFFFFFF)]
 
 
@@ -67,7 +87,7 @@ class MeshShape(_Strict):
     vertices and faces written out."""
 
     type: Literal["mesh"]
-    path: str | None = None
+    path: Path | None = None
     vertices: list[Vector3] | None = None
     faces: list[tuple[Integer, Integer, Integer]] | None = None
 
@@ -104,7 +124,7 @@ class Material(_Strict):
 
 
 class _Placed(_Strict):
-    name: str | None = Field(default=None, min_length=1)
+    name: Name | None = None
     shape: Shape | None = None
     shapes: list[Part] | None = None
     position: Vector3 = (0.0, 0.0, 0.0)
@@ -240,7 +260,7 @@ class Link(_Strict):
     """One link: its joint to ``parent`` (a link name; omitted: the base), its frame in the parent's frame at
     zero displacement, its geometry and mass in its own frame."""
 
-    name: str = Field(min_length=1)
+    name: Name
     joint: LinkJoint
     parent: str | None = None
     position: Vector3 = (0.0, 0.0, 0.0)
@@ -256,7 +276,7 @@ class Articulation(_Strict):
     """A tree of links (``tumble.Articulation``) put into the world at its coordinates ``q``, ``qd``: its links
     become bodies named ``NAME/LINK``, its joints world joints (``World.add_articulation``)."""
 
-    name: str = Field(min_length=1)
+    name: Name
     base_position: Vector3 = (0.0, 0.0, 0.0)
     base_orientation: Quaternion = (1.0, 0.0, 0.0, 0.0)
     links: list[Link] = Field(min_length=1)
@@ -356,7 +376,7 @@ class Vehicle(_Strict):
     following a ``trajectory`` (both or neither), or fixed rotor ``commands``."""
 
     type: Literal["quadrotor"]
-    name: str | None = Field(default=None, min_length=1)
+    name: Name | None = None
     params: Literal["crazyflie", "hummingbird"] | QuadrotorParams = "crazyflie"
     layout: Literal["x", "+"] = "x"
     position: Vector3 = (0.0, 0.0, 0.0)
@@ -418,7 +438,7 @@ class WorldSettings(_Strict):
 
 class Recording(_Strict):
     every: Annotated[int, Strict(), Field(ge=1, le=2**31 - 1)] = 1
-    path: str | None = None
+    path: Path | None = None
 
 
 class Scene(_Strict):
