@@ -83,7 +83,11 @@ def as_unit_vector3(name: str, value, *, tiny: float = 1e-12) -> np.ndarray:
 def as_quaternion(name: str, value) -> np.ndarray:
     """One finite, non-zero quaternion ``[w, x, y, z]``, returned normalised to unit length."""
     q = as_array(name, value, (4,), batch=False)
-    norm = float(np.linalg.norm(q))
+    with np.errstate(over="ignore"):
+        norm = float(np.linalg.norm(q))
+    if math.isinf(norm):  # finite components whose squares overflow: scale them down first
+        q = q / np.max(np.abs(q))
+        norm = float(np.linalg.norm(q))
     if norm < 1e-12:
         raise ValueError(f"{name} must be a non-zero quaternion [w, x, y, z], got {_show(q)}")
     return q / norm

@@ -264,8 +264,16 @@ class MassProperties:
 
 
 def _total_mass(mass, density, measure: float) -> float:
-    """The mass from ``mass=`` or ``density=`` times ``measure`` (a volume, or an area for shells)."""
+    """The mass from ``mass=`` or ``density=`` times ``measure`` (a volume, or an area for shells).
+
+    Raises:
+        ValueError: sizes so small or so large that ``measure`` is 0 or not finite (the mass would be spread over
+            nothing, or the moments overflow).
+    """
     kind, value = mass_or_density(mass, density)
+    if not 0.0 < measure < math.inf:
+        raise ValueError(f"the sizes give a volume of {measure!r}: too {'small' if measure == 0.0 else 'large'} for a "
+                         "float; give sizes between about 1e-100 and 1e100 m")  # fmt: skip
     return value if kind == "mass" else value * measure
 
 
@@ -288,7 +296,7 @@ def solid_sphere(radius, *, mass=None, density=None) -> MassProperties:
         mass: [kg], or density: [kg/m³] over the volume ``4/3 π r³``.
     """
     r = as_float("radius", radius, positive=True)
-    m = _total_mass(mass, density, 4.0 / 3.0 * math.pi * r**3)
+    m = _total_mass(mass, density, 4.0 / 3.0 * math.pi * r * r * r)
     return _diagonal(m, [0.4 * m * r * r] * 3)
 
 
@@ -300,7 +308,7 @@ def hollow_sphere(radius, *, mass=None, density=None) -> MassProperties:
         mass: [kg], or density: an AREAL density [kg/m²] over the surface ``4 π r²``.
     """
     r = as_float("radius", radius, positive=True)
-    m = _total_mass(mass, density, 4.0 * math.pi * r**2)
+    m = _total_mass(mass, density, 4.0 * math.pi * r * r)
     return _diagonal(m, [2.0 / 3.0 * m * r * r] * 3)
 
 
@@ -328,8 +336,8 @@ def box(extents, *, mass=None, density=None) -> MassProperties:
 
     ``I = m/12 diag(y² + z², x² + z², x² + y²)`` (course deck 002; deck 000's ``m/10`` is a typo).
     """
-    x, y, z = _positive_extents(extents)
-    m = _total_mass(mass, density, float(x * y * z))
+    x, y, z = map(float, _positive_extents(extents))  # Python floats: an overflow is inf, with no warning
+    m = _total_mass(mass, density, x * y * z)
     return _diagonal(m, [m / 12.0 * (y * y + z * z), m / 12.0 * (x * x + z * z), m / 12.0 * (x * x + y * y)])
 
 
@@ -375,13 +383,15 @@ def capsule(radius, length, *, mass=None, density=None) -> MassProperties:
     r = as_float("radius", radius, positive=True)
     length_ = as_float("length", length, nonnegative=True)
     cylinder_volume = math.pi * r * r * length_
-    hemisphere_volume = 2.0 / 3.0 * math.pi * r**3
+    hemisphere_volume = 2.0 / 3.0 * math.pi * r * r * r
     volume = cylinder_volume + 2.0 * hemisphere_volume
     m = _total_mass(mass, density, volume)
     m_c = m * cylinder_volume / volume
     m_h = m * hemisphere_volume / volume
     axial = 0.5 * m_c * r * r + 0.8 * m_h * r * r
-    side = m_c * (3.0 * r * r + length_**2) / 12.0 + 2.0 * m_h * (0.4 * r * r + 0.25 * length_**2 + 0.375 * length_ * r)
+    side = m_c * (3.0 * r * r + length_ * length_) / 12.0 + 2.0 * m_h * (
+        0.4 * r * r + 0.25 * length_ * length_ + 0.375 * length_ * r
+    )
     return _diagonal(m, [side, side, axial])
 
 

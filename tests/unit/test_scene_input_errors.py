@@ -175,3 +175,29 @@ def test_the_api_refuses_a_body_name_with_a_nul():
 
     with pytest.raises(ValueError, match=r"name must not hold a NUL character .* got 'a\\x00b'"):
         tumble.World().add_body(tumble.Sphere(0.1), mass=1.0, name="a\x00b")
+
+
+def test_a_quaternion_of_huge_components_is_normalised_not_zeroed():
+    import numpy as np
+
+    import tumble
+
+    body = tumble.World().add_body(tumble.Sphere(0.1), mass=1.0, orientation=[8.66e299, 0.0, 0.0, 5e299])
+    np.testing.assert_allclose(body.orientation, np.array([8.66, 0.0, 0.0, 5.0]) / np.hypot(8.66, 5.0), rtol=1e-15)
+    assert np.isfinite(body.angular_velocity).all()
+
+
+@pytest.mark.parametrize(
+    ("make", "expected"),
+    [
+        (lambda m: m.capsule(0.04, 3.5e299, mass=1.0), "inertia must be finite"),  # length² overflowed: OverflowError
+        (lambda m: m.capsule(4e-302, 0.1, mass=1.0), "the sizes give a volume of 0.0: too small"),  # 0 division
+        (lambda m: m.solid_sphere(1e-200, density=1.0), "the sizes give a volume of 0.0: too small"),
+        (lambda m: m.box((1e200, 1e200, 1e200), mass=1.0), "the sizes give a volume of inf: too large"),
+    ],
+)
+def test_mass_properties_of_sizes_past_the_float_range_are_refused_by_name(make, expected):
+    from tumble import mass
+
+    with pytest.raises(ValueError, match=expected):
+        make(mass)

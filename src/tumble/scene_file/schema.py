@@ -27,7 +27,7 @@ Positive = Annotated[float, Strict(), Field(gt=0.0, allow_inf_nan=False)]
 NonNegative = Annotated[float, Strict(), Field(ge=0.0, allow_inf_nan=False)]
 Vector3 = tuple[Finite, Finite, Finite]
 Quaternion = tuple[Finite, Finite, Finite, Finite]
-Integer = Annotated[int, Strict()]
+Index = Annotated[int, Strict(), Field(ge=0, le=2**31 - 1)]  # into a list of vertices
 
 
 def _without_nul(text: str) -> str:
@@ -89,7 +89,7 @@ class MeshShape(_Strict):
     type: Literal["mesh"]
     path: Path | None = None
     vertices: list[Vector3] | None = None
-    faces: list[tuple[Integer, Integer, Integer]] | None = None
+    faces: list[tuple[Index, Index, Index]] | None = None
 
     @model_validator(mode="after")
     def _one_source(self):
