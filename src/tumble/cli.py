@@ -314,8 +314,9 @@ def _cmd_run(args) -> int:
     duration = args.duration if args.duration is not None else float(settings.duration)
     every = args.every if args.every is not None else int(settings.record_every)
     if not duration / dt <= MAX_STEPS:
-        raise BadInput(f"--duration {duration:g} at --dt {dt:g} is {duration / dt:g} steps; a run takes at most "
-                       f"{MAX_STEPS:.0e}")  # fmt: skip
+        given = (f"--duration {duration:g}" if args.duration is not None else f"the scene's duration {duration:g} s",
+                 f"--dt {dt:g}" if args.dt is not None else f"the scene's dt {dt:g} s")  # fmt: skip
+        raise BadInput(f"{given[0]} at {given[1]} is {duration / dt:g} steps; a run takes at most {MAX_STEPS:.0e}")
     steps = round(duration / dt)
     if steps < 1:
         raise BadInput(f"--duration {duration:g} is shorter than one step of --dt {dt:g}")

@@ -201,3 +201,23 @@ def test_mass_properties_of_sizes_past_the_float_range_are_refused_by_name(make,
 
     with pytest.raises(ValueError, match=expected):
         make(mass)
+
+
+def test_a_scene_of_too_many_steps_says_whose_values_they_are(capsys, tmp_path):
+    path = tmp_path / "long.toml"
+    path.write_text(GOOD.replace("[world]", "[world]\ndt = 1e-300\nduration = 1e300"))
+    status, err = _status(capsys, "run", str(path), "-q")
+    assert status == EXIT_BAD_INPUT
+    assert "the scene's duration 1e+300 s at the scene's dt 1e-300 s is inf steps" in err
+
+
+def test_an_unwritable_recording_path_or_view_output_is_refused_before_anything_runs(capsys, tmp_path):
+    path = tmp_path / "good.toml"
+    path.write_text(GOOD.replace("every = 1", 'every = 1\npath = "/proc/tumble-test.h5"'))
+    status, err = _status(capsys, "run", str(path), "--duration", "0.05", "-q")
+    assert status == EXIT_BAD_INPUT and "/proc/tumble-test.h5: cannot write it:" in err
+    trajectory = tmp_path / "run.h5"
+    status, err = _status(capsys, "run", str(path), "--duration", "0.05", "-q", "--out", str(trajectory))
+    assert status == 0, err
+    status, err = _status(capsys, "view", str(trajectory), "-o", "/proc/tumble-test.html")
+    assert status == EXIT_BAD_INPUT and "/proc/tumble-test.html: cannot write it:" in err
