@@ -13,6 +13,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import tumble
+from scene_fuzz import _places
 from tumble import scene_file, scenes
 from tumble.scene_file import SceneError
 
@@ -165,14 +166,8 @@ JUNK = st.one_of(st.none(), st.booleans(), st.integers(-3, 3), st.floats(allow_n
                  st.integers(), max_size=2))  # fmt: skip
 
 
-def _paths(node, prefix=()):
-    yield prefix
-    if isinstance(node, dict):
-        for key, value in node.items():
-            yield from _paths(value, (*prefix, key))
-    elif isinstance(node, list):
-        for k, value in enumerate(node):
-            yield from _paths(value, (*prefix, k))
+def _paths(node):
+    return (path for path, _ in _places(node))
 
 
 BASE = tomllib.loads(
