@@ -21,6 +21,8 @@ Run from the repository root:
                  tumble against RotorPy (``benchmarks/quadrotor.py``).
 ``build``        building worlds of 1k to 100k free bodies and 1k to 10k joints (a chain, a grid) through the API
                  and from scene files, beside MuJoCo compiling the same bodies from MJCF (``benchmarks/build.py``).
+``broad_phase``  world bounds and sort-and-sweep pairs alone, on a pile and a scatter of 1k and 5k shapes
+                 (``benchmarks/broad_phase.py``; tumble only: no peer exposes its broad phase).
 
 Every timing is the best of ``--repeat`` runs after a first call that is reported apart (it includes the
 JIT compile or the load from Numba's disk cache). Both engines run in the same process, so compare the
@@ -50,7 +52,7 @@ import numpy as np
 
 import tumble
 
-from . import articulation, build, contact, joints, peers, quadrotor
+from . import articulation, broad_phase, build, contact, joints, peers, quadrotor
 
 __all__ = [
     "BENCHMARKS",
@@ -103,6 +105,7 @@ class Sizes:
     rotorpy_seconds: float = 10.0  # at most this much for RotorPy's own flights
     build_bodies: tuple[int, ...] = (1_000, 10_000, 100_000)  # worlds built (benchmarks/build.py)
     build_joints: tuple[int, ...] = (1_000, 10_000)
+    broad_phase_shapes: tuple[int, ...] = (1_000, 5_000)  # benchmarks/broad_phase.py
 
 
 FULL = Sizes()
@@ -111,6 +114,7 @@ QUICK = Sizes(
     cold_start=False, cold_start_bodies=8, pile_boxes=27, pile_seconds=0.2, pyramid_base=4, pyramid_seconds=0.2,
     cubes_boxes=(8, 27), cubes_seconds=0.2, big_pyramid_base=6, big_pyramid_seconds=0.2, chain_links=4,
     chain_seconds=0.2, quadrotor_seconds=0.2, rotorpy_seconds=0.2, build_bodies=(100, 400), build_joints=(100, 400),
+    broad_phase_shapes=(50,),
 )  # fmt: skip
 
 
@@ -698,6 +702,7 @@ BENCHMARKS: dict[str, Callable[[Sizes], list[dict]]] = {
     ),
     "quadrotor": quadrotor.bench_quadrotor,
     "build": build.bench_build,
+    "broad_phase": broad_phase.bench_broad_phase,
 }
 OPTIONAL = ("big_pyramid",)  # slow: run only when asked for with --only
 

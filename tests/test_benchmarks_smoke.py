@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import math
 import sys
 from pathlib import Path
@@ -78,9 +79,12 @@ def test_targets_table_and_csv(tmp_path):
     assert {t["met"] for t in targets} <= {"yes", "NO"}
 
 
-def test_cold_start_scripts_compile():
+def test_cold_start_scripts_run_and_print_their_timings(capsys):
     for order in ("step first", "simulate first"):
-        compile(run.cold_start_script(2, order), "<cold start>", "exec")
+        exec(compile(run.cold_start_script(2, order), "<cold start>", "exec"), {})  # here: warm, in-process
+        timings = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
+        assert set(timings) == {"import_s", "first_step_s", "first_simulate_s"}
+        assert all(value >= 0.0 for value in timings.values())
 
 
 def test_drift_measure_agrees_with_tumble_diagnostics():
@@ -245,3 +249,14 @@ def test_build_rows_for_every_world_and_way_and_the_same_world_each_way(tmp_path
     for case in ("free bodies", "chain", "grid"):
         model = mujoco.MjModel.from_xml_string(build.mjcf(case, 30))
         assert model.nbody - 1 == build.api_world(case, 30).model.body_count - (case == "free bodies")
+
+
+def test_broad_phase_rows_for_both_worlds_and_pairs_in_the_pile():
+    from benchmarks import broad_phase
+
+    rows = broad_phase.bench_broad_phase(run.Sizes(**{**run.QUICK.__dict__, "broad_phase_shapes": (50,)}))
+    _assert_finite_numbers(rows)
+    assert [(r["world"], r["shapes"]) for r in rows] == [("pile", 50), ("scatter", 50)]
+    # 50 boxes 1 cm apart with a 2 cm margin (5 rows of 10): the bounds of every neighbour overlap, along the rows
+    # (5 * 9), across them (4 * 10) and on both diagonals (2 * 4 * 9).
+    assert rows[0]["pairs"] == 5 * 9 + 4 * 10 + 2 * 4 * 9

@@ -2,6 +2,9 @@
 
 Kernels never validate (they cannot raise); everything a user hands to tumble passes through one of
 these functions first. Nothing is silently clipped: a value is accepted as given or refused.
+
+This module sits below everything it checks and imports nothing of tumble: a check that needs a tumble type
+lives beside that type (``rotation.as_rotation``, ``handles.as_body``).
 """
 
 from __future__ import annotations
@@ -16,7 +19,6 @@ __all__ = [
     "as_array",
     "as_vector3",
     "as_quaternion",
-    "as_rotation",
     "mass_or_density",
 ]
 
@@ -93,19 +95,6 @@ def as_quaternion(name: str, value) -> np.ndarray:
     return q / norm
 
 
-def as_rotation(name: str, value) -> np.ndarray:
-    """A rotation given as a unit quaternion (4,) or a proper rotation matrix (3, 3); returns the matrix."""
-    array = np.asarray(value, dtype=np.float64) if not isinstance(value, (str, bytes)) else None
-    if array is not None and array.shape == (4,):
-        from .rotation import quat_to_matrix
-
-        return quat_to_matrix(as_quaternion(name, array))
-    matrix = as_array(name, value, (3, 3), batch=False)
-    if not np.allclose(matrix.T @ matrix, np.eye(3), atol=1e-6) or np.linalg.det(matrix) < 0.0:
-        raise ValueError(f"{name} must be a proper rotation matrix (orthonormal, det +1), got {_show(matrix)}")
-    return matrix.copy()
-
-
 def mass_or_density(mass, density) -> tuple[str, float]:
     """Exactly one of ``mass=`` or ``density=``, positive and finite: returns ``("mass"|"density", value)``."""
     if (mass is None) == (density is None):
@@ -120,34 +109,3 @@ def as_seed(value) -> int | None:
     if value is not None and (isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 0):
         raise ValueError(f"seed must be an integer >= 0 or None, got {value!r}")
     return None if value is None else int(value)
-
-
-def as_body(value):
-    """A body handle (``world.add_body``'s answer)."""
-    from .handles import Body
-
-    if not isinstance(value, Body):
-        raise TypeError(f"body must be a tumble.Body (from world.add_body), got {value!r}")
-    return value
-
-
-def as_new_part(world, part, kind: type, name: str, article: str, described: str):
-    """``part`` (an actuator, a sensor), a ``kind``, in no world yet, on a dynamic body of ``world``; ``name`` and
-    its ``article`` name it in messages, ``described`` says what it must be."""
-    if not isinstance(part, kind):
-        raise TypeError(f"{name} must be {described}, got {part!r}")
-    if part._world is not None:
-        raise ValueError(f"{part!r} is in a world already")
-    as_dynamic_body_of(world, part.body, f"{article} {name}")
-    return part
-
-
-def as_dynamic_body_of(world, value, what: str):
-    """A body of ``world`` that moves, for ``what`` (an actuator, a sensor, drag) to act on or read."""
-    body = as_body(value)
-    name = body.name or body.index
-    if body._world is not world:
-        raise ValueError(f"body {name!r} belongs to another world; {what} needs a body of this one")
-    if body.is_static:
-        raise ValueError(f"body {name!r} is static: {what} needs a dynamic body")
-    return body

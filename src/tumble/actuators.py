@@ -20,8 +20,9 @@ import math
 
 import numpy as np
 
-from ._validate import as_body, as_dynamic_body_of, as_float, as_new_part, as_unit_vector3, as_vector3
+from ._validate import as_float, as_unit_vector3, as_vector3
 from .dynamics.actuation import ROTOR, THRUSTER, ActuatorArrays
+from .handles import as_body, as_dynamic_body_of, as_new_part
 
 __all__ = ["Actuator", "Rotor", "Thruster", "command_all"]
 

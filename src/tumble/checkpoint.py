@@ -206,10 +206,8 @@ def save_world(world, path: str | os.PathLike) -> Path:
     return path
 
 
-def load_world(path: str | os.PathLike, cls=None):
-    """A new :class:`~tumble.World` (or ``cls``) in the state that :func:`save_world` wrote to ``path``."""
-    if cls is None:
-        from .world import World as cls
+def load_world(path: str | os.PathLike, cls):
+    """A new ``cls`` (:class:`~tumble.World`, which calls this) in the state :func:`save_world` wrote to ``path``."""
     source = os.fspath(path)
     try:
         with np.load(path, allow_pickle=False) as data:

@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from ._validate import as_quaternion, as_vector3
-from .dynamics.joint_solver import LOWER, MAX_MOTOR, MOTOR_SPEED, TARGET, UPPER
+from .dynamics.joint_solver import LOWER, MAX_MOTOR, MOTOR_SPEED, TARGET, UPPER, JointKind
 from .rotation import quat_rotate, quat_to_matrix
 
 __all__ = ["Body", "Joint"]
@@ -273,8 +273,6 @@ class Joint:
     @property
     def kind(self) -> str:
         """``"ball"``, ``"hinge"``, ``"slider"``, ``"fixed"`` or ``"distance"``."""
-        from .joints import JointKind
-
         return JointKind(self._spec().kind).name.lower()
 
     @property
@@ -468,3 +466,32 @@ class Joint:
         label_a = self.body_a.name or self.body_a.index
         label_b = "world" if b is None else (b.name or b.index)
         return f"Joint(#{self._index}, {self.kind}, a={label_a!r}, b={label_b!r})"
+
+
+def as_body(value):
+    """A body handle (``world.add_body``'s answer)."""
+    if not isinstance(value, Body):
+        raise TypeError(f"body must be a tumble.Body (from world.add_body), got {value!r}")
+    return value
+
+
+def as_new_part(world, part, kind: type, name: str, article: str, described: str):
+    """``part`` (an actuator, a sensor), a ``kind``, in no world yet, on a dynamic body of ``world``; ``name`` and
+    its ``article`` name it in messages, ``described`` says what it must be."""
+    if not isinstance(part, kind):
+        raise TypeError(f"{name} must be {described}, got {part!r}")
+    if part._world is not None:
+        raise ValueError(f"{part!r} is in a world already")
+    as_dynamic_body_of(world, part.body, f"{article} {name}")
+    return part
+
+
+def as_dynamic_body_of(world, value, what: str):
+    """A body of ``world`` that moves, for ``what`` (an actuator, a sensor, drag) to act on or read."""
+    body = as_body(value)
+    name = body.name or body.index
+    if body._world is not world:
+        raise ValueError(f"body {name!r} belongs to another world; {what} needs a body of this one")
+    if body.is_static:
+        raise ValueError(f"body {name!r} is static: {what} needs a dynamic body")
+    return body

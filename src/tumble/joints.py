@@ -24,12 +24,13 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from enum import IntEnum
 
 import numpy as np
 
 from ._validate import as_float, as_unit_vector3, as_vector3
 from .builder import JointSpec
+from .dynamics.joint_solver import JointKind
+from .handles import Body
 from .rotation import matrix_to_quat, quat_conjugate, quat_multiply, quat_rotate
 
 __all__ = [
@@ -40,16 +41,6 @@ __all__ = [
     "JointKind",
     "SliderJoint",
 ]
-
-
-class JointKind(IntEnum):
-    """Joint type codes in the model arrays (``model.joints.kind``)."""
-
-    BALL = 0
-    HINGE = 1
-    SLIDER = 2
-    FIXED = 3
-    DISTANCE = 4
 
 
 def _bounds(name_lower: str, lower, name_upper: str, upper) -> tuple[float, float]:
@@ -286,8 +277,6 @@ def _frame_with_x_along(axis: np.ndarray) -> np.ndarray:
 
 
 def _check_body(world, name: str, body, allow_none: bool):
-    from .handles import Body
-
     if body is None and allow_none:
         return None
     if not isinstance(body, Body):

@@ -22,7 +22,8 @@ import numbers
 
 import numpy as np
 
-from ._validate import as_array, as_float, as_rotation, as_vector3, mass_or_density
+from ._validate import as_array, as_float, as_vector3, mass_or_density
+from .rotation import as_rotation
 
 __all__ = [
     "MassProperties",

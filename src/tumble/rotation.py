@@ -24,7 +24,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from ._validate import _show, as_array
+from ._validate import _show, as_array, as_quaternion
 
 __all__ = [
     "skew",
@@ -605,3 +605,14 @@ def from_scipy(rotation: Rotation) -> np.ndarray:
         )
     xyzw = np.asarray(rotation.as_quat(), dtype=np.float64)
     return _positive_w(xyzw[..., [3, 0, 1, 2]])
+
+
+def as_rotation(name: str, value) -> np.ndarray:
+    """A rotation given as a unit quaternion (4,) or a proper rotation matrix (3, 3); returns the matrix."""
+    array = np.asarray(value, dtype=np.float64) if not isinstance(value, (str, bytes)) else None
+    if array is not None and array.shape == (4,):
+        return quat_to_matrix(as_quaternion(name, array))
+    matrix = as_array(name, value, (3, 3), batch=False)
+    if not np.allclose(matrix.T @ matrix, np.eye(3), atol=1e-6) or np.linalg.det(matrix) < 0.0:
+        raise ValueError(f"{name} must be a proper rotation matrix (orthonormal, det +1), got {_show(matrix)}")
+    return matrix.copy()

@@ -24,7 +24,8 @@ from __future__ import annotations
 import numpy as np
 
 from . import diagnostics
-from ._validate import as_body, as_float, as_new_part, as_seed, as_vector3
+from ._validate import as_float, as_seed, as_vector3
+from .handles import as_body, as_new_part
 from .rotation import quat_from_rotvec, quat_multiply, quat_to_matrix
 
 __all__ = ["IMU", "Pose", "Sensor", "Sensors"]

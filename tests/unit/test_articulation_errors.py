@@ -312,4 +312,5 @@ def test_import_tumble_loads_the_articulation_only_when_used():
         "import sys, tumble; assert 'tumble.articulation' not in sys.modules; "
         "from tumble import Revolute; assert tumble.Articulation.__module__.startswith('tumble.articulation')"
     )
-    subprocess.run([sys.executable, "-c", code], check=True, timeout=120)
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert result.returncode == 0, result.stderr

@@ -6,9 +6,6 @@ the hundreds so the whole file also runs quickly with ``NUMBA_DISABLE_JIT=1``.
 
 from __future__ import annotations
 
-import time
-
-import numba
 import numpy as np
 import pytest
 
@@ -18,7 +15,6 @@ from tumble.geometry.packing import pack_geometry
 from tumble.rotation import quat_normalize, quat_to_matrix
 
 IDENTITY = np.array([1.0, 0.0, 0.0, 0.0])
-JIT = not numba.config.DISABLE_JIT
 
 
 class Scene:
@@ -399,45 +395,3 @@ def test_plane_pairs_obey_the_filters():
     assert scene.pairs(excluded_body_pairs=[[1, 0]]) == []
     scene.body_is_dynamic[0] = False
     assert scene.pairs() == []
-
-
-# --- performance (printed, not asserted) -----------------------------------------------------------------
-
-
-def test_performance_is_printed(capsys):
-    sizes = [1000, 5000] if JIT else [100]
-    rng = np.random.default_rng(0)
-    for n in sizes:
-        for name, scene in [
-            ("pile", box_scene(n)),
-            ("scatter", random_scene(rng, n, spread=1.3 * n ** (1 / 3), mesh=False)),
-        ]:
-            lo, hi = np.zeros((len(scene.shapes), 3)), np.zeros((len(scene.shapes), 3))
-            args = (scene.geom, scene.body_pos, scene.body_quat, scene.body_linvel, 0.02, 1 / 60, lo, hi)
-            buffer = bp.PairBuffer()
-            bp.update_aabbs(*args)
-            bp.find_pairs(
-                scene.geom, scene.body_pos, scene.body_quat, lo, hi, scene.body_is_dynamic, margin=0.02, buffer=buffer
-            )
-            best_bounds = best_pairs = np.inf
-            for _ in range(5):
-                t0 = time.perf_counter()
-                bp.update_aabbs(*args)
-                t1 = time.perf_counter()
-                a, _ = bp.find_pairs(
-                    scene.geom,
-                    scene.body_pos,
-                    scene.body_quat,
-                    lo,
-                    hi,
-                    scene.body_is_dynamic,
-                    margin=0.02,
-                    buffer=buffer,
-                )
-                t2 = time.perf_counter()
-                best_bounds, best_pairs = min(best_bounds, t1 - t0), min(best_pairs, t2 - t1)
-            with capsys.disabled():
-                print(
-                    f"\nbroad phase {name} {len(scene.shapes)} shapes: update_aabbs {1e3 * best_bounds:.3f} ms, "
-                    f"find_pairs {1e3 * best_pairs:.3f} ms, {len(a)} pairs"
-                )

@@ -33,7 +33,8 @@ def cartesian():
 
 def test_import_tumble_does_not_import_sympy():
     code = "import sys, tumble; assert 'sympy' not in sys.modules, 'tumble imported sympy'"
-    subprocess.run([sys.executable, "-c", code], check=True, timeout=120)
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert result.returncode == 0, result.stderr
 
 
 # --- coordinates -------------------------------------------------------------------------------------

@@ -5,7 +5,8 @@ registers before the next one (body-major order). That is cache friendly, lets t
 with each row written by one thread only, and gives bit-identical results in any order or thread count.
 
 Large calls split the bodies into one contiguous block per core and run the same kernel on each block in a
-thread (the kernel releases the GIL). Set ``TUMBLE_THREADS=1`` to stay on one thread.
+thread (the kernel releases the GIL). Set ``TUMBLE_THREADS=1`` to stay on one thread (``auto``, unset or empty:
+one per core; anything else is warned about and read as ``auto``).
 
 If a body's state becomes non-finite, its row keeps the last good values and the kernel reports the first
 failing step; :func:`advance_free_bodies` then restores every body to where it stood before the call and
@@ -15,6 +16,7 @@ replays exactly the steps that all bodies completed, so the world stops at its l
 from __future__ import annotations
 
 import os
+import warnings
 from concurrent.futures import ThreadPoolExecutor
 from typing import NamedTuple
 
@@ -27,12 +29,35 @@ from ..params import Integrator
 from ..state import State
 from .free_motion import euler_step, midpoint_step, rk4_step, symplectic_step
 
-__all__ = ["Recording", "advance_free_bodies", "PARALLEL_MIN_WORK"]
+__all__ = ["Recording", "advance_free_bodies", "PARALLEL_MIN_WORK", "thread_count"]
 
 # Below this many body-steps per call the threads cost more than they save (measured: one body for 20 000
 # steps ran 5 % slower split across threads).
 PARALLEL_MIN_WORK = 200_000
-_THREADS = max(1, min(os.cpu_count() or 1, int(os.environ.get("TUMBLE_THREADS", os.cpu_count() or 1))))
+
+
+def thread_count(setting: str | None, cores: int | None) -> int:
+    """The threads ``TUMBLE_THREADS=setting`` asks for on ``cores`` cores: an integer >= 1 (at most one per
+    core), or one per core for ``auto``, unset or empty; anything else warns and falls back to one per core."""
+    cores = max(1, cores or 1)
+    text = (setting or "").strip()
+    if text.lower() in ("", "auto"):
+        return cores
+    try:
+        asked = int(text)
+    except ValueError:
+        asked = 0
+    if asked < 1:
+        warnings.warn(
+            f"TUMBLE_THREADS={setting!r} is not a number of threads >= 1 or 'auto'; using one per core ({cores})",
+            RuntimeWarning,
+            stacklevel=2,
+        )
+        return cores
+    return min(asked, cores)
+
+
+_THREADS = thread_count(os.environ.get("TUMBLE_THREADS"), os.cpu_count())
 _POOL: ThreadPoolExecutor | None = None
 
 

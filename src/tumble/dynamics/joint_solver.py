@@ -32,6 +32,7 @@ What each joint applied to body ``b`` over the step is summed into ``force_total
 from __future__ import annotations
 
 import math
+from enum import IntEnum
 from typing import NamedTuple
 
 import numpy as np
@@ -56,10 +57,21 @@ from ..math3d import (
 from .contact_solver import _apply_impulse
 from .softness import soft_coefficients
 
-__all__ = ["JointArrays", "joint_coordinates", "solve_joints", "warm_start_joints"]
+__all__ = ["JointArrays", "JointKind", "joint_coordinates", "solve_joints", "warm_start_joints"]
 
-# Joint kinds (tumble.joints.JointKind)
-BALL, HINGE, SLIDER, FIXED, DISTANCE = 0, 1, 2, 3, 4
+BALL, HINGE, SLIDER, FIXED, DISTANCE = 0, 1, 2, 3, 4  # joint kinds, as plain ints for the kernels
+
+
+class JointKind(IntEnum):
+    """Joint type codes in the model arrays (``model.joints.kind``; public as ``tumble.joints.JointKind``)."""
+
+    BALL = BALL
+    HINGE = HINGE
+    SLIDER = SLIDER
+    FIXED = FIXED
+    DISTANCE = DISTANCE
+
+
 # Columns of JointArrays.drive
 LOWER, UPPER, MOTOR_SPEED, MAX_MOTOR, SPRING_HERTZ, SPRING_RATIO, TARGET, CONE = 0, 1, 2, 3, 4, 5, 6, 7
 # Columns of the drive impulses (state.joint_drive_impulse)

@@ -1,0 +1,143 @@
+"""The code base's own rules, checked on its source: no import cycles between tumble's modules, and no test that
+asserts nothing (a test that cannot fail proves nothing)."""
+
+from __future__ import annotations
+
+import ast
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parents[2]
+SOURCE = REPO / "src"
+
+
+def _module(path: Path) -> str:
+    parts = list(path.relative_to(SOURCE).with_suffix("").parts)
+    return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+
+
+def _imports(path: Path) -> set[str]:
+    """The tumble modules ``path`` imports, at its top or inside a function (a lazy import is still a dependency)."""
+    module = _module(path)
+    package = module if path.name == "__init__.py" else module.rpartition(".")[0]
+    found = set()
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        if isinstance(node, ast.ImportFrom):
+            base = package.split(".")[: len(package.split(".")) - (node.level - 1)] if node.level else []
+            target = ".".join(base + ([node.module] if node.module else []))
+            found.add(target)
+            found.update(f"{target}.{alias.name}" for alias in node.names)  # ``from . import module``
+        elif isinstance(node, ast.Import):
+            found.update(alias.name for alias in node.names)
+    return found
+
+
+def _import_graph() -> dict[str, set[str]]:
+    """Module -> the modules it imports. Packages' ``__init__`` files only gather their modules' names for users,
+    so an import of a package is left out (else every module of it would sit in a circle with its package)."""
+    paths = {_module(p): p for p in (SOURCE / "tumble").rglob("*.py")}
+    packages = {name for name, p in paths.items() if p.name == "__init__.py"}
+    return {
+        name: {m for m in _imports(p) if m in paths and m not in packages and m != name}
+        for name, p in paths.items()
+        if name not in packages
+    }
+
+
+def _cycles(graph: dict[str, set[str]]) -> list[list[str]]:
+    """The strongly connected components of more than one module (Tarjan 1972), iteratively."""
+    index, low, on_stack, stack, components = {}, {}, set(), [], []
+    for root in graph:
+        if root in index:
+            continue
+        work = [(root, iter(sorted(graph[root])))]
+        index[root] = low[root] = len(index)
+        stack.append(root)
+        on_stack.add(root)
+        while work:
+            node, edges = work[-1]
+            for nxt in edges:
+                if nxt not in index:
+                    index[nxt] = low[nxt] = len(index)
+                    stack.append(nxt)
+                    on_stack.add(nxt)
+                    work.append((nxt, iter(sorted(graph[nxt]))))
+                    break
+                if nxt in on_stack:
+                    low[node] = min(low[node], index[nxt])
+            else:
+                work.pop()
+                if work:
+                    low[work[-1][0]] = min(low[work[-1][0]], low[node])
+                if low[node] == index[node]:
+                    component = []
+                    while True:
+                        member = stack.pop()
+                        on_stack.discard(member)
+                        component.append(member)
+                        if member == node:
+                            break
+                    if len(component) > 1:
+                        components.append(sorted(component))
+    return components
+
+
+def test_the_cycle_finder_finds_a_circle_and_only_it():
+    graph = {"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": {"a"}, "e": set()}
+    assert _cycles(graph) == [["a", "b", "c"]]
+    assert _cycles({"a": {"b"}, "b": set()}) == []
+
+
+def test_no_module_of_tumble_imports_itself_through_others():
+    graph = _import_graph()
+    assert {"tumble._validate", "tumble.rotation", "tumble.handles", "tumble.joints"} <= set(graph)
+    assert _cycles(graph) == []
+
+
+def test_validation_helpers_import_nothing_of_tumble():
+    assert _import_graph()["tumble._validate"] == set()
+
+
+# --- tests that assert something ------------------------------------------------------------------------------
+
+_CHECKING_CALLS = ("raises", "warns", "fail", "deprecated_call", "importorskip", "skip", "xfail")
+
+
+def _checks(function: ast.AST, helpers: set[str]) -> bool:
+    """Whether ``function`` can fail: an assert or raise, pytest.raises/warns/fail, an ``assert*``/``check*``/
+    ``expect*`` call (numpy.testing's included), or a call of a helper of its file that itself checks."""
+    for node in ast.walk(function):
+        if isinstance(node, (ast.Assert, ast.Raise)):
+            return True
+        if isinstance(node, ast.Call):
+            func = node.func
+            name = func.attr if isinstance(func, ast.Attribute) else getattr(func, "id", "")
+            if name in _CHECKING_CALLS or name in helpers or name.lstrip("_").startswith(("assert", "check", "expect")):
+                return True
+    return False
+
+
+def _tests_that_check_nothing(source: str) -> list[str]:
+    functions = [n for n in ast.walk(ast.parse(source)) if isinstance(n, (ast.FunctionDef, ast.AsyncFunctionDef))]
+    helpers: set[str] = set()
+    for _ in range(4):  # helpers that call helpers
+        helpers |= {f.name for f in functions if not f.name.startswith("test") and _checks(f, helpers)}
+    return [f.name for f in functions if f.name.startswith("test") and not _checks(f, helpers)]
+
+
+def test_the_scan_tells_a_test_that_checks_from_one_that_does_not():
+    source = (
+        "def helper(x):\n    assert x\n"
+        "def test_a():\n    helper(1)\n"
+        "def test_b():\n    print('timing')\n"
+        "def test_c():\n    with pytest.raises(ValueError):\n        int('x')\n"
+    )
+    assert _tests_that_check_nothing(source) == ["test_b"]
+
+
+def test_every_test_asserts_something():
+    silent = [
+        f"{path.relative_to(REPO)}::{name}"
+        for path in sorted((REPO / "tests").rglob("test_*.py"))
+        for name in _tests_that_check_nothing(path.read_text(encoding="utf-8"))
+    ]
+    assert silent == []
