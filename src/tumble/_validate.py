@@ -11,16 +11,35 @@ from __future__ import annotations
 
 import math
 import numbers
+import os
 
 import numpy as np
 
 __all__ = [
+    "MAX_COUNT",
+    "MAX_STEPS",
+    "MIN_STEP",
+    "as_count",
+    "as_filter",
+    "as_material",
+    "as_step",
+    "step_count",
+    "require_memory",
+    "scaled_down",
+    "vector_norm",
     "as_float",
     "as_array",
     "as_vector3",
     "as_quaternion",
     "mass_or_density",
 ]
+
+
+MAX_STEPS = 10**15  # steps in one call or run: more would not end, and their count must stay an exact integer
+MAX_COUNT = 2**31 - 1  # a count the kernels hold as an index (record_every, chunk frames)
+# [s] The smallest step: the solvers divide by the substep, whose reciprocal must stay finite with room to spare
+# (a subnormal step overflows it); no physical time scale comes near.
+MIN_STEP = 1e-300
 
 
 def _show(value) -> str:
@@ -50,6 +69,83 @@ def as_float(name: str, value, *, positive: bool = False, nonnegative: bool = Fa
     return x
 
 
+def as_count(name: str, value, maximum: int = MAX_COUNT) -> int:
+    """An integer from 1 to ``maximum`` (a Python or NumPy integer; not a bool, not a float)."""
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)) or not 1 <= value <= maximum:
+        raise ValueError(f"{name} must be an integer from 1 to {maximum}, got {_show(value)}")
+    return int(value)
+
+
+def as_step(name: str, dt, time: float) -> float:
+    """A step size ``dt`` [s] that advances ``time``: finite, at least :data:`MIN_STEP`, and not lost in the
+    rounding of ``time + dt``."""
+    dt = as_float(name, dt, positive=True)
+    if dt < MIN_STEP or not time + dt > time:
+        raise ValueError(
+            f"{name}={dt!r} is too small to advance time from t = {time!r} s (a step must be at least {MIN_STEP:g} s "
+            "and change t)"
+        )
+    return dt
+
+
+def physical_memory() -> int | None:
+    """This machine's memory [bytes], or None where the system does not say."""
+    try:
+        return os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+    except (AttributeError, OSError, ValueError):
+        return None
+
+
+def _bytes(count: float) -> str:
+    for unit in ("bytes", "KiB", "MiB", "GiB", "TiB"):
+        if count < 1024:
+            return f"{count:.3g} {unit}"
+        count /= 1024
+    return f"{count:.3g} PiB"
+
+
+def require_memory(need: float, what: str, instead: str) -> None:
+    """Refuse to allocate ``need`` bytes for ``what`` beyond this machine's memory (an allocation that would
+    fail, or swap for hours): the ValueError says how much it would take and what to do ``instead``."""
+    have = physical_memory()
+    if have is not None and need > have:
+        raise ValueError(
+            f"{what} would take {_bytes(need)}, more than this machine's {_bytes(have)} of memory: {instead}"
+        )
+
+
+def step_count(duration: float, dt: float) -> int:
+    """``round(duration / dt)`` for a positive ``duration`` and step ``dt``: at least one step, at most
+    :data:`MAX_STEPS`."""
+    steps = duration / dt
+    if not steps <= MAX_STEPS:
+        raise ValueError(
+            f"duration={duration!r} at dt={dt!r} is {steps:g} steps; one call takes at most {MAX_STEPS:.0e} "
+            "(split the run, or take a larger dt)"
+        )
+    if round(steps) < 1:
+        raise ValueError(f"duration={duration!r} is shorter than one step of dt={dt!r}")
+    return round(steps)
+
+
+def as_filter(name: str, bits) -> int:
+    """A collision filter: an integer of 32 bits."""
+    if isinstance(bits, (bool, np.bool_)) or not isinstance(bits, (int, np.integer)):
+        raise TypeError(f"{name} must be an integer of 32 bits (0 to 0xFFFFFFFF), got {bits!r} ({type(bits).__name__})")
+    if not 0 <= int(bits) <= 0xFFFFFFFF:
+        raise ValueError(f"{name} must be an integer of 32 bits (0 to 0xFFFFFFFF), got {int(bits)}")
+    return int(bits)
+
+
+def as_material(friction, restitution, rolling_resistance) -> tuple[float, float, float]:
+    """``(friction, restitution, rolling_resistance)``: all >= 0, restitution at most 1."""
+    friction = as_float("friction", friction, nonnegative=True)
+    restitution = as_float("restitution", restitution, nonnegative=True)
+    if restitution > 1.0:
+        raise ValueError(f"restitution must be in [0, 1], got {restitution!r}")
+    return friction, restitution, as_float("rolling_resistance", rolling_resistance, nonnegative=True)
+
+
 def as_array(name: str, value, trailing_shape: tuple[int, ...], *, batch: bool = True) -> np.ndarray:
     """A finite float64 array whose last dimensions are ``trailing_shape`` (leading batch dims allowed)."""
     if isinstance(value, (str, bytes)) or value is None:
@@ -68,6 +164,33 @@ def as_array(name: str, value, trailing_shape: tuple[int, ...], *, batch: bool =
     return array
 
 
+# Vectors whose norm lies in this range have squares well inside float range (so do their components).
+_SQUARES_SAFE = (1e-150, 1e150)
+
+
+def scaled_down(array: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(array / s, s)`` with one scale ``s`` per vector of the last axis: 1 where the squares of the vector's
+    components stay in float range (the vector is then returned bit for bit), its largest magnitude where they
+    would overflow or underflow, so that a norm or a direction computed from ``array / s`` stays exact to
+    round-off (the scaling of LAPACK's ``dnrm2``, applied only where it is needed)."""
+    with np.errstate(over="ignore", under="ignore"):
+        norm = np.linalg.norm(array, axis=-1)
+    risky = ~((norm > _SQUARES_SAFE[0]) & (norm < _SQUARES_SAFE[1]))
+    if not np.any(risky):
+        return array, np.ones_like(norm)
+    largest = np.max(np.abs(array), axis=-1)
+    scale = np.where(risky & (largest > 0.0), largest, 1.0)
+    return array / scale[..., None], scale
+
+
+def vector_norm(array: np.ndarray) -> np.ndarray:
+    """``|v|`` over the last axis without overflow or underflow in the squares (inf only where ``|v|`` itself
+    exceeds the largest float)."""
+    scaled, scale = scaled_down(array)
+    with np.errstate(over="ignore"):
+        return np.linalg.norm(scaled, axis=-1) * scale
+
+
 def as_vector3(name: str, value) -> np.ndarray:
     """One finite 3-vector (a fresh float64 array of shape (3,))."""
     return as_array(name, value, (3,), batch=False).copy()
@@ -76,23 +199,21 @@ def as_vector3(name: str, value) -> np.ndarray:
 def as_unit_vector3(name: str, value, *, tiny: float = 1e-12) -> np.ndarray:
     """One finite 3-vector longer than ``tiny``, returned normalised (an axis, a normal, a direction)."""
     vector = as_vector3(name, value)
-    norm = float(np.linalg.norm(vector))
-    if not norm > tiny:
+    scaled, scale = scaled_down(vector)
+    norm = float(np.linalg.norm(scaled))
+    if not norm * scale > tiny:
         raise ValueError(f"{name} must be a non-zero vector, got {vector.tolist()}")
-    return vector / norm
+    return scaled / norm
 
 
 def as_quaternion(name: str, value) -> np.ndarray:
     """One finite, non-zero quaternion ``[w, x, y, z]``, returned normalised to unit length."""
     q = as_array(name, value, (4,), batch=False)
-    with np.errstate(over="ignore"):
-        norm = float(np.linalg.norm(q))
-    if math.isinf(norm):  # finite components whose squares overflow: scale them down first
-        q = q / np.max(np.abs(q))
-        norm = float(np.linalg.norm(q))
-    if norm < 1e-12:
+    scaled, scale = scaled_down(q)
+    norm = float(np.linalg.norm(scaled))
+    if norm * scale < 1e-12:
         raise ValueError(f"{name} must be a non-zero quaternion [w, x, y, z], got {_show(q)}")
-    return q / norm
+    return scaled / norm
 
 
 def mass_or_density(mass, density) -> tuple[str, float]:

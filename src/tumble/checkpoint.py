@@ -29,10 +29,11 @@ from pathlib import Path
 import numpy as np
 
 from . import shapes as _shapes
+from ._validate import as_filter, as_material, as_vector3
 from .builder import JointSpec, ModelBuilder, ShapeSpec, _BodyRow
 from .geometry.manifold import MAX_POINTS
 from .inputs import Inputs
-from .mass import MassProperties
+from .mass import MassProperties, require_invertible
 from .params import Params, SolverSettings
 from .state import State
 
@@ -106,6 +107,10 @@ class _Encoder:
         return self._shape_ids[id(shape)]
 
 
+class _Invalid(ValueError):
+    """A checkpoint found damaged; its message names the file (raised as is, never wrapped again)."""
+
+
 class _Decoder:
     """The inverse of :class:`_Encoder`, rebuilding only whitelisted classes."""
 
@@ -115,7 +120,7 @@ class _Decoder:
         self._shapes = [self._shape(spec) for spec in shapes]
 
     def _fail(self, what: str) -> ValueError:
-        return ValueError(f"{self._source!r} is not a valid tumble checkpoint: {what}")
+        return _Invalid(f"{self._source!r} is not a valid tumble checkpoint: {what}")
 
     def __call__(self, value):
         if isinstance(value, list):
@@ -224,11 +229,23 @@ def load_world(path: str | os.PathLike, cls):
             f"{source!r} is a checkpoint of format version {manifest.get('format_version')!r}; this tumble reads "
             f"version {FORMAT_VERSION}"
         )
-    decode = _Decoder(arrays, manifest["shapes"], source)
-    params, builder = decode(manifest["params"]), decode(manifest["builder"])
-    state, inputs = decode(manifest["state"]), decode(manifest["inputs"])
-    _check_consistent(builder, state, inputs, source)
-    return cls._from_builder(builder, state, inputs, gravity=decode(manifest["gravity"]), params=params)
+    try:
+        decode = _Decoder(arrays, manifest["shapes"], source)
+        parts = {key: decode(manifest[key]) for key in ("params", "builder", "state", "inputs", "gravity")}
+        for key, kind in (("params", Params), ("builder", ModelBuilder), ("state", State), ("inputs", Inputs)):
+            if not isinstance(parts[key], kind):
+                raise decode._fail(f"{key} is {type(parts[key]).__name__}, expected {kind.__name__}")
+        builder, state, inputs = parts["builder"], parts["state"], parts["inputs"]
+        _check_consistent(builder, state, inputs, source)
+        _check_values(builder, state, inputs, source)
+        # Through the public checks again: the integrator, gravity and every solver setting.
+        return cls._from_builder(builder, state, inputs, gravity=parts["gravity"], params=parts["params"])
+    except _Invalid:
+        raise
+    except KeyError as error:
+        raise _Invalid(f"{source!r} is not a valid tumble checkpoint: no entry {error}") from None
+    except (TypeError, ValueError, AttributeError, IndexError, OverflowError) as error:
+        raise _Invalid(f"{source!r} is not a valid tumble checkpoint: {error}") from None
 
 
 def _check_consistent(builder: ModelBuilder, state: State, inputs: Inputs, source: str) -> None:
@@ -261,7 +278,99 @@ def _check_consistent(builder: ModelBuilder, state: State, inputs: Inputs, sourc
             if values.size and (values.min() < lo or values.max() >= hi):
                 problems.append(f"{name} outside {lo}..{hi - 1}")
     if problems:
-        raise ValueError(f"{source!r} is not a consistent tumble checkpoint: " + "; ".join(problems))
+        raise _Invalid(f"{source!r} is not a consistent tumble checkpoint: " + "; ".join(problems))
+
+
+def _check_values(builder: ModelBuilder, state: State, inputs: Inputs, source: str) -> None:
+    """Every value as the public API would have accepted it, so that a damaged file is refused here and not by a
+    step that fails later: finite numbers (joint limits may be infinite, never NaN), unit quaternions, materials,
+    filters, names and mass properties the API checks."""
+    problems = []
+
+    def check(where: str, test, *args) -> None:
+        try:
+            test(*args)
+        except (TypeError, ValueError, AttributeError, OverflowError) as error:
+            problems.append(f"{where}: {error}")
+
+    for i, row in enumerate(builder.rows):
+        where = f"body {i}"
+        if row.mass_properties is not None:
+            check(where, _require_mass, row.mass_properties)
+        check(where, _require_numbers, "linear_damping", row.linear_damping, True)
+        check(where, _require_numbers, "angular_damping", row.angular_damping, True)
+        check(where, as_vector3, "constant_force", row.constant_force)
+        check(where, as_vector3, "constant_torque", row.constant_torque)
+        if not (row.name is None or (isinstance(row.name, str) and row.name and "\0" not in row.name)):
+            problems.append(f"{where}: name {row.name!r}")
+        for k, spec in enumerate(row.shapes):
+            check(f"{where}, shape {k}", _require_shape, spec)
+    if len(builder.names) != sum(row.name is not None for row in builder.rows):
+        problems.append("two bodies share a name")
+    for j, spec in enumerate(builder.joints):
+        check(f"joint {j}", _require_joint, spec)
+    for f in dataclasses.fields(State):
+        value = getattr(state, f.name)
+        if f.name != "body_quat" and isinstance(value, (np.ndarray, float)) and np.asarray(value).dtype.kind == "f":
+            check("state", _require_numbers, f.name, value, f.name == "time" or f.name == "body_sleep_time")
+    check("state", _require_unit_quaternions, "body_quat", state.body_quat)
+    if not isinstance(state.step_count, int) or isinstance(state.step_count, bool) or state.step_count < 0:
+        problems.append(f"state: step_count {state.step_count!r}")
+    for name in ("body_force", "body_torque"):
+        check("inputs", _require_numbers, name, getattr(inputs, name))
+    if problems:
+        shown = "; ".join(problems[:5]) + (f"; and {len(problems) - 5} more" if len(problems) > 5 else "")
+        raise _Invalid(f"{source!r} is not a valid tumble checkpoint: {shown}")
+
+
+def _require_numbers(name: str, value, nonnegative: bool = False, allow_inf: bool = False) -> None:
+    array = np.asarray(value)
+    if array.dtype.kind not in "fiu" or (array.dtype.kind == "f" and isinstance(value, bool)):
+        raise TypeError(f"{name} is {type(value).__name__}, not numbers")
+    bad = np.isnan(array) if allow_inf else ~np.isfinite(array)
+    if nonnegative:
+        bad |= array < 0
+    if bad.any():
+        raise ValueError(f"{name} holds {array[bad].ravel()[0]!r}")
+
+
+def _require_unit_quaternions(name: str, value) -> None:
+    _require_numbers(name, value)
+    norms = np.linalg.norm(np.asarray(value, dtype=np.float64).reshape(-1, 4), axis=1)
+    if norms.size and not np.all(np.abs(norms - 1.0) < 1e-6):
+        raise ValueError(f"{name} holds a quaternion of norm {norms[np.argmax(np.abs(norms - 1.0))]!r}, not 1")
+
+
+def _require_mass(mp) -> None:
+    if not isinstance(mp, MassProperties):
+        raise TypeError(f"mass properties are {type(mp).__name__}")
+    require_invertible(mp)
+
+
+def _require_shape(spec) -> None:
+    if not isinstance(spec, ShapeSpec) or not isinstance(spec.shape, _shapes.Shape):
+        raise TypeError(f"{type(spec).__name__} holding {type(getattr(spec, 'shape', None)).__name__}, not a shape")
+    as_vector3("position", spec.position)
+    _require_unit_quaternions("quat", spec.quat)
+    as_material(spec.friction, spec.restitution, spec.rolling_resistance)
+    as_filter("group", spec.group)
+    as_filter("mask", spec.mask)
+
+
+def _require_joint(spec) -> None:
+    from .dynamics.joint_solver import JointKind
+
+    if not isinstance(spec, JointSpec):
+        raise TypeError(f"{type(spec).__name__}, not a joint")
+    JointKind(spec.kind)
+    for name in ("local_anchor_a", "local_anchor_b"):
+        as_vector3(name, getattr(spec, name))
+    for name in ("local_frame_a", "local_frame_b"):
+        _require_unit_quaternions(name, getattr(spec, name))
+    drive = np.asarray(spec.drive)
+    if drive.shape != (8,):
+        raise ValueError(f"drive of shape {drive.shape}, expected (8,)")
+    _require_numbers("drive", drive, allow_inf=True)
 
 
 def _describe(value) -> str:

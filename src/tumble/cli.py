@@ -32,14 +32,14 @@ import time
 import weakref
 from pathlib import Path
 
+from ._validate import MAX_COUNT, MAX_STEPS
+
 __all__ = ["main", "EXIT_OK", "EXIT_SIMULATION", "EXIT_BAD_INPUT", "EXIT_INTERRUPTED"]
 
 EXIT_OK = 0
 EXIT_SIMULATION = 1
 EXIT_BAD_INPUT = 2
 EXIT_INTERRUPTED = 130
-MAX_STEPS = 1e15  # steps in one run: more would not end, and their count must stay an exact integer
-MAX_COUNT = 2**31 - 1  # --every, --max-frames: what the kernels hold as an index (scene files: recording.every)
 
 TRAJECTORY_SUFFIXES = (".h5", ".hdf5", ".he5", ".npz")
 PLOT_KINDS = ("energy", "momentum", "omega", "paths", "flight")

@@ -15,6 +15,19 @@ from .rotation import quat_rotate, quat_to_matrix
 __all__ = ["Body", "Joint"]
 
 
+def _listed(value) -> list | None:
+    return None if value is None else np.asarray(value, dtype=float).tolist()
+
+
+def _finite(result: np.ndarray, name: str, given, what: str) -> np.ndarray:
+    """``result``, computed from the argument ``name`` = ``given``, if finite; else a ValueError that says ``what``
+    ``given`` gave (the caller writes nothing: a refused call changes nothing)."""
+    with np.errstate(over="ignore", invalid="ignore"):
+        if np.isfinite(result).all():
+            return result
+    raise ValueError(f"{name}={_listed(given)} {what} {_listed(result)}, which overflows (non-finite)")
+
+
 class Body:
     """A rigid body of a :class:`~tumble.World` (dynamic or static)."""
 
@@ -76,7 +89,9 @@ class Body:
         value = as_vector3("position", value)
         self._require_dynamic("position")
         com, quat, _, _ = self._row()
-        com[:] = value + quat_rotate(quat, self._mass()[1])
+        with np.errstate(over="ignore", invalid="ignore"):
+            com_position = value + quat_rotate(quat, self._mass()[1])
+        com[:] = _finite(com_position, "position", value, "puts the centre of mass at")
 
     @property
     def orientation(self) -> np.ndarray:
@@ -125,7 +140,10 @@ class Body:
     def angular_velocity(self, value) -> None:
         value = as_vector3("angular_velocity", value)
         self._require_dynamic("angular_velocity")
-        self._row()[3][:] = self.inertia_world @ value
+        with np.errstate(over="ignore", invalid="ignore"):
+            momentum = self.inertia_world @ value
+        momentum = _finite(momentum, "angular_velocity", value, "gives the angular momentum")
+        self._row()[3][:] = momentum
 
     @property
     def angular_velocity_body(self) -> np.ndarray:
@@ -176,23 +194,37 @@ class Body:
     def _lever(self, point) -> np.ndarray:
         if point is None:
             return np.zeros(3)
-        return as_vector3("point", point) - self._row()[0]
+        with np.errstate(over="ignore", invalid="ignore"):  # an overflowing lever shows in the moment it gives
+            return as_vector3("point", point) - self._row()[0]
 
     def apply_force(self, force, point=None) -> None:
-        """Apply ``force`` [N] at world ``point`` (default the COM) during the next step only."""
+        """Apply ``force`` [N] at world ``point`` (default the COM) during the next step only.
+
+        Raises:
+            ValueError: the force's moment, or its sum with the loads already applied for the step, overflows (the
+                loads are then left as they were).
+        """
         force = as_vector3("force", force)
         lever = self._lever(point)
         with np.errstate(over="ignore", invalid="ignore"):
             moment = np.cross(lever, force)
-        if not np.all(np.isfinite(moment)):
-            raise ValueError(
-                f"force {force.tolist()} at point {np.asarray(point).tolist()} has a moment about the centre of mass "
-                "that overflows (non-finite)"
-            )
+        moment = _finite(moment, "force", force, f"at point {_listed(point)} has the moment")
         self._require_dynamic("apply_force")
-        inputs = self._world.inputs
-        inputs.body_force[self._index] += force
-        inputs.body_torque[self._index] += moment
+        self._add_loads("apply_force", force, moment)
+
+    def _add_loads(self, what: str, force: np.ndarray, torque: np.ndarray) -> None:
+        """Add to the loads of the next step, both or neither (a sum that overflows is refused)."""
+        inputs, i = self._world.inputs, self._index
+        with np.errstate(over="ignore", invalid="ignore"):
+            total_force, total_torque = inputs.body_force[i] + force, inputs.body_torque[i] + torque
+        for total, pending, unit in ((total_force, inputs.body_force[i], "N"), (total_torque, inputs.body_torque[i],
+                                                                             "N m")):  # fmt: skip
+            if not np.isfinite(total).all():
+                raise ValueError(
+                    f"{what}: adding {_listed(force if unit == 'N' else torque)} to the {_listed(pending)} {unit} "
+                    f"already applied to body {self.name or i!r} for the next step overflows (non-finite)"
+                )
+        inputs.body_force[i], inputs.body_torque[i] = total_force, total_torque
 
     @property
     def constant_force(self) -> np.ndarray:
@@ -221,20 +253,35 @@ class Body:
             getattr(model, f"body_{name}")[self._index] = value
 
     def apply_torque(self, torque) -> None:
-        """Apply ``torque`` [N m] (world frame) during the next step only."""
+        """Apply ``torque`` [N m] (world frame) during the next step only.
+
+        Raises:
+            ValueError: its sum with the torques already applied for the step overflows (they are left as they were).
+        """
         torque = as_vector3("torque", torque)
         self._require_dynamic("apply_torque")
-        self._world.inputs.body_torque[self._index] += torque
+        self._add_loads("apply_torque", np.zeros(3), torque)
 
     def apply_impulse(self, impulse, point=None) -> None:
-        """Change the momenta at once: ``Δp = J``, ``ΔL = r × J`` (so ``Δv = J / m``, ``Δω = I_w⁻¹ (r × J)``)."""
+        """Change the momenta at once: ``Δp = J``, ``ΔL = r × J`` (so ``Δv = J / m``, ``Δω = I_w⁻¹ (r × J)``).
+
+        Raises:
+            ValueError: the velocity, angular momentum or angular velocity it would give overflows (the body is then
+                left as it was).
+        """
         impulse = as_vector3("impulse", impulse)
         lever = self._lever(point)
         self._require_dynamic("apply_impulse")
         inv_mass = 1.0 / self.mass  # as the model's body_inv_mass holds it
         _, _, linvel, angmom = self._row()
-        linvel += impulse * inv_mass
-        angmom += np.cross(lever, impulse)
+        r = self.rotation
+        with np.errstate(over="ignore", invalid="ignore"):
+            velocity, momentum = linvel + impulse * inv_mass, angmom + np.cross(lever, impulse)
+            omega = r @ (self._mass()[3] @ (r.T @ momentum))
+        velocity = _finite(velocity, "impulse", impulse, f"on a body of {self.mass:g} kg gives the velocity")
+        _finite(momentum, "impulse", impulse, f"at point {_listed(point)} gives the angular momentum")
+        _finite(omega, "impulse", impulse, "gives the angular velocity")
+        linvel[:], angmom[:] = velocity, momentum
 
     def __eq__(self, other) -> bool:
         return isinstance(other, Body) and other._world is self._world and other._index == self._index

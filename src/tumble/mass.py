@@ -573,3 +573,20 @@ def mesh(vertices, faces, *, mass=None, density=None) -> MassProperties:
     rho = m / volume
     inertia = rho * (np.trace(second) * np.eye(3) - second)
     return MassProperties(m, centroid, 0.5 * (inertia + inertia.T))
+
+
+def require_invertible(mp: MassProperties) -> None:
+    """A dynamic body's mass and inertia must be invertible: the solver works with 1/m and I⁻¹."""
+    with np.errstate(over="ignore", divide="ignore"):
+        inverse = 1.0 / mp.mass
+    if not math.isfinite(inverse):
+        raise ValueError(f"mass={mp.mass!r} is too small for a dynamic body: 1/mass overflows")
+    moments = mp._principal_moments()
+    with np.errstate(over="ignore", divide="ignore"):
+        smallest_inverse = 1.0 / moments[0]
+    if moments[0] > 0.0 and not math.isfinite(smallest_inverse):
+        raise ValueError(f"inertia must be invertible for a dynamic body, got principal moments {moments.tolist()}")
+    if moments[0] <= 1e-12 * moments[-1]:
+        raise ValueError(
+            f"inertia must be positive definite for a dynamic body, got principal moments {moments.tolist()}"
+        )

@@ -103,7 +103,16 @@ def mat_vec(m, v):
 
 @inline
 def solve33(m, b):
-    """``M⁻¹ b`` by Cramer's rule (``M`` well conditioned: an inertia-like matrix)."""
+    """``M⁻¹ b`` by Cramer's rule (``M`` well conditioned: an inertia-like matrix).
+
+    ``M`` and ``b`` are first scaled by the power of two nearest ``1 / max |M_ij|`` (exact: it changes no bit of the
+    answer), so that the determinant, a product of three entries, neither overflows nor underflows for the
+    inertia of a body of 1e-100 or 1e300 kg."""
+    largest = max(abs(m[0]), abs(m[1]), abs(m[2]), abs(m[3]), abs(m[4]), abs(m[5]), abs(m[6]), abs(m[7]), abs(m[8]))
+    scale = math.ldexp(1.0, -math.frexp(largest)[1]) if 0.0 < largest < math.inf else 1.0
+    m = (m[0] * scale, m[1] * scale, m[2] * scale, m[3] * scale, m[4] * scale, m[5] * scale, m[6] * scale,
+         m[7] * scale, m[8] * scale)  # fmt: skip
+    b = (b[0] * scale, b[1] * scale, b[2] * scale)
     c0 = (m[4] * m[8] - m[5] * m[7], m[5] * m[6] - m[3] * m[8], m[3] * m[7] - m[4] * m[6])
     det = m[0] * c0[0] + m[1] * c0[1] + m[2] * c0[2]
     inv_det = 1.0 / det

@@ -22,7 +22,8 @@ Bodies with contacts (the soft step of DESIGN.md):
     to_angular_momentum   scratch.body_angvel    -> state.body_angmom      (dynamics/substep.py)
 
 Actuators and drag act inside the integrators, from each stage's or substep's state (dynamics/actuation.py).
-Then, either way: advance time, the step count and the motors' speeds, and clear the applied loads.
+Then, either way: advance time, the step count and the motors' speeds, and clear the applied loads (also when a
+step failed: the world keeps its state from before it, without the loads that were to act in it).
 """
 
 from __future__ import annotations
@@ -76,8 +77,9 @@ def simulate_steps(
         )  # fmt: skip
         _advance_clock(state, h, steps_done)
         advance_motors(acts, steps_done * h)
-    if steps_done > 0:
-        inputs.clear()
+    # The applied loads act in the first step; one that failed drops them too (the world keeps its state from
+    # before it), or a load that makes every step overflow (RK4 sums four stages of it) would leave it stuck.
+    inputs.clear()
     return steps_done, failing_body
 
 

@@ -26,7 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from . import trajectory_io
-from ._validate import as_float
+from ._validate import as_count, as_float, as_step, step_count
 from .errors import SimulationError
 from .trajectory import Trajectory
 from .trajectory_io import FRAME_ARRAYS
@@ -43,12 +43,6 @@ def default_chunk_frames(body_count: int) -> int:
     """Frames per chunk for ``body_count`` bodies: about 4 MiB, at least 16 and at most 1024 frames."""
     frame_bytes = 8 * (_FRAME_VALUES_PER_BODY * max(1, body_count) + 3)
     return int(min(1024, max(16, _CHUNK_BYTES // frame_bytes)))
-
-
-def _check_count(name: str, value) -> int:
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
-        raise ValueError(f"{name} must be an integer >= 1, got {value!r}")
-    return int(value)
 
 
 def _scene_dict(scene) -> dict | None:
@@ -108,12 +102,12 @@ class TrajectoryWriter:
     def __init__(self, path, world, *, every: int = 1, chunk_frames: int | None = None, scene=None,
                  dt: float | None = None, compression: str | None = None) -> None:  # fmt: skip
         self.path = Path(path)
-        self.every = _check_count("every", every)
+        self.every = as_count("every", every)
         model = world.model
         self.body_count = model.body_count
         if chunk_frames is None:
             chunk_frames = default_chunk_frames(self.body_count)
-        self.chunk_frames = _check_count("chunk_frames", chunk_frames)
+        self.chunk_frames = as_count("chunk_frames", chunk_frames)
         if dt is not None:
             dt = as_float("dt", dt, positive=True)
         self.metadata = run_metadata(world, dt=dt, every=self.every, scene=_scene_dict(scene))
@@ -331,10 +325,8 @@ def record(world, duration: float, dt: float, path, *, every: int = 1, chunk_fra
             chunk written before the interruption.
     """
     duration = as_float("duration", duration, positive=True)
-    dt = as_float("dt", dt, positive=True)
-    n_steps = round(duration / dt)
-    if n_steps < 1:
-        raise ValueError(f"duration={duration!r} is shorter than one step of dt={dt!r}")
+    dt = as_step("dt", dt, world.time)
+    n_steps = step_count(duration, dt)
     writer = TrajectoryWriter(path, world, every=every, chunk_frames=chunk_frames, scene=scene, dt=dt,
                               compression=compression)  # fmt: skip
     log = VehicleLog(world, writer.every) if world._vehicles else None

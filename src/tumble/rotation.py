@@ -24,7 +24,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from ._validate import _show, as_array, as_quaternion
+from ._validate import _show, as_array, as_quaternion, scaled_down, vector_norm
 
 __all__ = [
     "skew",
@@ -78,14 +78,22 @@ def _where(mask: np.ndarray) -> str:
     return f" at index {index}"
 
 
-def _nonzero_norm(name: str, q: np.ndarray) -> np.ndarray:
-    """The norms ``|q|`` over the last axis, refusing a (near-)zero quaternion that has no rotation."""
-    norm = np.linalg.norm(q, axis=-1)
-    bad = norm < _MIN_QUAT_NORM
+def _nonzero(name: str, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(q', |q'|)`` with ``q'`` the same rotation as ``q`` scaled where its squares would overflow
+    (``_validate.scaled_down``; ``q`` itself elsewhere), refusing a (near-)zero quaternion that has no rotation."""
+    scaled, scale = scaled_down(q)
+    norm = np.linalg.norm(scaled, axis=-1)
+    with np.errstate(over="ignore"):
+        bad = norm * scale < _MIN_QUAT_NORM
     if np.any(bad):
         first = q[tuple(np.argwhere(bad)[0])] if bad.ndim else q
         raise ValueError(f"{name} must be a non-zero quaternion [w, x, y, z], got {_show(first)}{_where(bad)}")
-    return norm
+    return scaled, norm
+
+
+def _unit(name: str, q: np.ndarray) -> np.ndarray:
+    scaled, norm = _nonzero(name, q)
+    return scaled / norm[..., None]
 
 
 def _stack(*components) -> np.ndarray:
@@ -181,8 +189,11 @@ def quat_inverse(q) -> np.ndarray:
         ValueError: a quaternion in ``q`` is zero.
     """
     q = as_array("q", q, (4,))
-    norm = _nonzero_norm("q", q)
-    return quat_conjugate(q) / (norm * norm)[..., None]
+    scaled, norm = _nonzero("q", q)
+    if scaled is q:
+        return quat_conjugate(q) / (norm * norm)[..., None]
+    true_norm = vector_norm(q)[..., None]  # q⁻¹ = q* / |q|², divided twice so that |q|² cannot overflow
+    return quat_conjugate(q) / true_norm / true_norm
 
 
 def quat_normalize(q) -> np.ndarray:
@@ -198,7 +209,7 @@ def quat_normalize(q) -> np.ndarray:
         ValueError: a quaternion in ``q`` is zero (it has no direction, so it is refused rather than guessed).
     """
     q = as_array("q", q, (4,))
-    return q / _nonzero_norm("q", q)[..., None]
+    return _unit("q", q)
 
 
 def quat_rotate(q, v) -> np.ndarray:
@@ -223,7 +234,7 @@ def quat_rotate(q, v) -> np.ndarray:
     """
     q = as_array("q", q, (4,))
     v = as_array("v", v, (3,))
-    norm = _nonzero_norm("q", q)
+    q, norm = _nonzero("q", q)
     w = q[..., 0:1]
     u = q[..., 1:]
     t = np.cross(u, v) * (2.0 / (norm * norm))[..., None]
@@ -237,7 +248,7 @@ def _sin_half_over(angle: np.ndarray) -> np.ndarray:
     """``sin(θ/2) / θ``, with its Taylor series ``½ - θ²/48 + θ⁴/3840`` near zero (where it is 0/0)."""
     small = angle < _SMALL_ANGLE
     safe = np.where(small, 1.0, angle)
-    a2 = angle * angle
+    a2 = np.where(small, angle, 0.0) ** 2  # the series' argument only where it is used (θ² of 1e200 overflows)
     return np.where(small, 0.5 - a2 / 48.0 + a2 * a2 / 3840.0, np.sin(0.5 * safe) / safe)
 
 
@@ -264,11 +275,12 @@ def quat_from_axis_angle(axis, angle) -> np.ndarray:
     """
     axis = as_array("axis", axis, (3,))
     angle = as_array("angle", angle, ())
-    length = np.linalg.norm(axis, axis=-1)
+    scaled, _ = scaled_down(axis)
+    length = np.linalg.norm(scaled, axis=-1)
     bad = length == 0.0
     if np.any(bad):
         raise ValueError(f"axis must be a non-zero vector, got {_show(axis)}{_where(bad)}")
-    unit = axis / np.where(bad, 1.0, length)[..., None]
+    unit = scaled / np.where(bad, 1.0, length)[..., None]
     half = 0.5 * angle
     return _stack(np.cos(half), *np.moveaxis(np.sin(half)[..., None] * unit, -1, 0))
 
@@ -290,8 +302,7 @@ def quat_to_axis_angle(q) -> tuple[np.ndarray, np.ndarray]:
     Raises:
         ValueError: a quaternion in ``q`` is zero.
     """
-    q = as_array("q", q, (4,))
-    _nonzero_norm("q", q)
+    q, _ = _nonzero("q", as_array("q", q, (4,)))
     # Use the representative with w >= 0, whose angle lies in [0, π].
     q = _positive_w(q)
     u = q[..., 1:]
@@ -322,7 +333,7 @@ def quat_from_rotvec(r) -> np.ndarray:
         array([1.e+00, 5.e-13, 0.e+00, 0.e+00])
     """
     r = as_array("r", r, (3,))
-    angle = np.linalg.norm(r, axis=-1)
+    angle = vector_norm(r)
     vector = _sin_half_over(angle)[..., None] * r
     return _stack(np.cos(0.5 * angle), *np.moveaxis(vector, -1, 0))
 
@@ -344,8 +355,7 @@ def quat_to_rotvec(q) -> np.ndarray:
     Raises:
         ValueError: a quaternion in ``q`` is zero.
     """
-    q = as_array("q", q, (4,))
-    _nonzero_norm("q", q)
+    q, _ = _nonzero("q", as_array("q", q, (4,)))
     q = _positive_w(q)
     w = q[..., 0]
     u = q[..., 1:]
@@ -379,8 +389,7 @@ def quat_to_matrix(q) -> np.ndarray:
     Raises:
         ValueError: a quaternion in ``q`` is zero.
     """
-    q = as_array("q", q, (4,))
-    norm = _nonzero_norm("q", q)
+    q, norm = _nonzero("q", as_array("q", q, (4,)))
     s = 2.0 / (norm * norm)
     w, x, y, z = q[..., 0], q[..., 1], q[..., 2], q[..., 3]
     xx, yy, zz = s * x * x, s * y * y, s * z * z
@@ -522,8 +531,8 @@ def quat_slerp(q0, q1, t) -> np.ndarray:
     q0 = as_array("q0", q0, (4,))
     q1 = as_array("q1", q1, (4,))
     t = as_array("t", t, ())
-    q0 = q0 / _nonzero_norm("q0", q0)[..., None]
-    q1 = q1 / _nonzero_norm("q1", q1)[..., None]
+    q0 = _unit("q0", q0)
+    q1 = _unit("q1", q1)
     # Shortest path: q1 and -q1 are the same rotation; take the one in q0's hemisphere.
     q1 = np.where(np.sum(q0 * q1, axis=-1, keepdims=True) < 0.0, -q1, q1)
     omega = 2.0 * np.arctan2(np.linalg.norm(q1 - q0, axis=-1), np.linalg.norm(q1 + q0, axis=-1))
@@ -577,8 +586,7 @@ def to_scipy(q) -> Rotation:
     Raises:
         ValueError: a quaternion in ``q`` is zero.
     """
-    q = as_array("q", q, (4,))
-    _nonzero_norm("q", q)
+    q, _ = _nonzero("q", as_array("q", q, (4,)))
     return Rotation.from_quat(q[..., [1, 2, 3, 0]])
 
 

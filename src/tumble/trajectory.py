@@ -10,6 +10,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import diagnostics, trajectory_io
+from ._validate import require_memory
 from .dynamics.integrate import Recording
 from .handles import Body
 from .rotation import quat_rotate
@@ -46,6 +47,9 @@ def _to_frame_origins(com_local: np.ndarray, com: np.ndarray, quat: np.ndarray) 
         local = np.broadcast_to(com_local[offset], (com.shape[0], offset.size, 3))
         com[:, offset] -= quat_rotate(quat[:, offset], local)
     return com
+
+
+RECORDED_FLOATS = 3 + 4 + 3 + 3  # per body and frame: position, orientation, velocity, angular momentum
 
 
 CSV_COLUMNS = ("time", "body", "x", "y", "z", "qw", "qx", "qy", "qz", "vx", "vy", "vz", "wx", "wy", "wz")
@@ -88,6 +92,16 @@ class Trajectory:
 
     @staticmethod
     def allocate_recording(body_count: int, frames: int) -> Recording:
+        """Room for ``frames`` frames of ``body_count`` bodies.
+
+        Raises:
+            ValueError: the recording and the trajectory made from it (about twice the recording) would not fit
+                in this machine's memory; the message says how much they would take.
+        """
+        need = 2 * frames * body_count * RECORDED_FLOATS * 8  # [bytes] the recording, then the trajectory
+        require_memory(need, f"recording {frames} frames of {body_count} bodies (and the trajectory made from them)",
+                       "record fewer frames (a larger record_every, a shorter duration) or stream them to a file "
+                       "(tumble.recording.record)")  # fmt: skip
         return Recording(
             np.empty((frames, body_count, 3)), np.empty((frames, body_count, 4)),
             np.empty((frames, body_count, 3)), np.empty((frames, body_count, 3)),

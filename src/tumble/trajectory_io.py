@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import json
 import os
+import zipfile
 from pathlib import Path
 
 import numpy as np
@@ -238,12 +239,63 @@ def _read_h5(path) -> tuple[dict, list[str], dict]:
 
 
 def read(path: str | os.PathLike) -> tuple[dict, list[str], dict]:
-    """``(arrays, body_names, metadata)`` from an ``.npz`` or HDF5 file (told apart by their first bytes)."""
+    """``(arrays, body_names, metadata)`` from an ``.npz`` or HDF5 file (told apart by their first bytes).
+
+    Raises:
+        FileNotFoundError: no file at ``path``.
+        ValueError: the file is not a tumble trajectory, or a damaged one (cut short, an array of the wrong shape or
+            type, metadata that is not a JSON object); one message names the file and what is wrong, and nothing is
+            returned half-read.
+    """
+    source = os.fspath(path)
     try:
         with open(path, "rb") as f:
             head = f.read(len(_HDF5_SIGNATURE))
     except FileNotFoundError:
-        raise FileNotFoundError(f"no trajectory file at {os.fspath(path)!r}") from None
-    if head == _HDF5_SIGNATURE:
-        return _read_h5(path)
-    return _read_npz(path)
+        raise FileNotFoundError(f"no trajectory file at {source!r}") from None
+    try:
+        arrays, names, metadata = _read_h5(path) if head == _HDF5_SIGNATURE else _read_npz(path)
+    except (FileNotFoundError, PermissionError, IsADirectoryError):
+        raise
+    except (OSError, EOFError, ValueError, KeyError, TypeError, UnicodeError, zipfile.BadZipFile) as error:
+        if isinstance(error, ValueError) and str(error).startswith(repr(source)):
+            raise  # already says which file and what
+        raise ValueError(f"{source!r} is not a readable tumble trajectory: {_reason(error)}") from None
+    problems = _problems(arrays, names, metadata)
+    if problems:
+        raise ValueError(f"{source!r} is not a valid tumble trajectory: " + "; ".join(problems))
+    return arrays, names, metadata
+
+
+def _reason(error: BaseException) -> str:
+    text = str(error)
+    if "pickled data" in text or "allow_pickle" in text:  # numpy's words for a file it does not know, or objects
+        return "not an .npz or HDF5 file of numbers (tumble never reads pickled Python objects)"
+    if isinstance(error, (EOFError, zipfile.BadZipFile)):
+        return f"the file is cut short or damaged ({type(error).__name__}: {text})"
+    return f"{type(error).__name__}: {text}" if text else type(error).__name__
+
+
+def _problems(arrays: dict, names: list[str], metadata) -> list[str]:
+    """What is wrong with the arrays read from a file: shapes that disagree, types that are not numbers."""
+    problems = []
+    for key in FRAME_ARRAYS + STATIC_ARRAYS:
+        if arrays[key].dtype.kind not in "fiu":
+            problems.append(f"{key} holds {arrays[key].dtype} values, not numbers")
+    if problems:
+        return problems
+    frames, bodies = arrays["time"].shape[0] if arrays["time"].ndim == 1 else -1, arrays["body_mass"].shape[0]
+    expected = {key: (frames, *(bodies if n is None else n for n in trailing)) for key, trailing in
+                _FRAME_SHAPES.items()}  # fmt: skip
+    expected.update(body_mass=(bodies,), body_inertia=(bodies, 3, 3), body_com_local=(bodies, 3), gravity=(3,))
+    for key, shape in expected.items():
+        if arrays[key].shape != shape:
+            problems.append(f"{key} has shape {arrays[key].shape}, expected {shape}")
+    if names and len(names) != bodies:
+        problems.append(f"{len(names)} body names for {bodies} bodies")
+    for name, channel in arrays.get("channels", {}).items():
+        if channel.dtype.kind not in "fiu" or channel.ndim < 1 or channel.shape[0] != frames:
+            problems.append(f"channel {name!r} is {channel.shape} {channel.dtype}, expected {frames} frames of numbers")
+    if not isinstance(metadata, dict):
+        problems.append(f"metadata is a JSON {type(metadata).__name__}, not an object")
+    return problems

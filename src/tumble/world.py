@@ -15,7 +15,19 @@ from collections.abc import Sequence
 import numpy as np
 
 from . import diagnostics
-from ._validate import as_float, as_quaternion, as_vector3, mass_or_density
+from ._validate import (
+    MAX_COUNT,
+    as_count,
+    as_filter,
+    as_float,
+    as_material,
+    as_quaternion,
+    as_step,
+    as_unit_vector3,
+    as_vector3,
+    mass_or_density,
+    step_count,
+)
 from .actuators import Actuation, Actuator
 from .builder import ModelBuilder, ShapeSpec
 from .control import Controller, Controllers, StepClock, controller_failed
@@ -23,7 +35,7 @@ from .errors import SimulationError
 from .flight import bad_rotor_speeds
 from .handles import Body, Joint
 from .inputs import Inputs
-from .mass import MassProperties
+from .mass import MassProperties, require_invertible
 from .model import Model
 from .params import DEFAULT_SOLVER, INTEGRATOR_NAMES, Params, SolverSettings
 from .pipeline import simulate_steps
@@ -52,14 +64,6 @@ def _check_integrator(integrator) -> str:
     if not isinstance(integrator, str) or integrator not in names:
         raise ValueError(f"integrator must be one of {names}, got {integrator!r}")
     return integrator
-
-
-def _check_filter(name: str, bits) -> int:
-    if isinstance(bits, (bool, np.bool_)) or not isinstance(bits, (int, np.integer)):
-        raise TypeError(f"{name} must be an integer of 32 bits (0 to 0xFFFFFFFF), got {bits!r} ({type(bits).__name__})")
-    if not 0 <= int(bits) <= 0xFFFFFFFF:
-        raise ValueError(f"{name} must be an integer of 32 bits (0 to 0xFFFFFFFF), got {int(bits)}")
-    return int(bits)
 
 
 def _check_dynamic_shapes(shape) -> None:
@@ -165,23 +169,6 @@ def _explicit_mass_properties(mass_properties, mass, density, inertia) -> MassPr
     return mass_properties
 
 
-def _require_definite(mp: MassProperties) -> None:
-    """A dynamic body's mass and inertia must be invertible: the solver works with 1/m and I⁻¹."""
-    with np.errstate(over="ignore", divide="ignore"):
-        inverse = 1.0 / mp.mass
-    if not math.isfinite(inverse):
-        raise ValueError(f"mass={mp.mass!r} is too small for a dynamic body: 1/mass overflows")
-    moments = mp._principal_moments()
-    with np.errstate(over="ignore", divide="ignore"):
-        smallest_inverse = 1.0 / moments[0]
-    if moments[0] > 0.0 and not math.isfinite(smallest_inverse):
-        raise ValueError(f"inertia must be invertible for a dynamic body, got principal moments {moments.tolist()}")
-    if moments[0] <= 1e-12 * moments[-1]:
-        raise ValueError(
-            f"inertia must be positive definite for a dynamic body, got principal moments {moments.tolist()}"
-        )
-
-
 class World:
     """A set of rigid bodies under gravity.
 
@@ -241,7 +228,8 @@ class World:
     def _from_builder(cls, builder: ModelBuilder, state: State, inputs: Inputs, *, gravity, params: Params) -> World:
         """A world over a filled builder and the state of its rows (a checkpoint's): handles made, model packed."""
         world = cls(gravity=gravity, integrator=params.integrator)
-        world._params, world._builder = params, builder
+        world.set_solver(**params.solver._asdict())  # checked as a user's settings would be
+        world._builder = builder
         world._bodies = [Body(world, i) for i in range(builder.body_count)]
         world._joints = [Joint(world, i) for i in range(len(builder.joints))]
         world._state, world._inputs = state, inputs
@@ -286,17 +274,17 @@ class World:
         quat = _IDENTITY.copy() if orientation is _NO_ROTATION else as_quaternion("orientation", orientation)
         velocity = _vector_or_origin("velocity", velocity)
         angular_velocity = _vector_or_origin("angular_velocity", angular_velocity)
-        material = self._check_material(friction, restitution, rolling_resistance)
+        material = as_material(friction, restitution, rolling_resistance)
         linear_damping = as_float("linear_damping", linear_damping, nonnegative=True)
         angular_damping = as_float("angular_damping", angular_damping, nonnegative=True)
         name = self._check_name(name)
-        group, mask = _check_filter("collision_group", collision_group), _check_filter("collision_mask", collision_mask)
+        group, mask = as_filter("collision_group", collision_group), as_filter("collision_mask", collision_mask)
         items = _shape_items(shape, material, group, mask)
         _check_dynamic_shapes(shape)
         mp = _explicit_mass_properties(mass_properties, mass, density, inertia)
         if mp is None:
             mp = _body_mass_properties(items, mass, density, inertia)
-        _require_definite(mp)
+        require_invertible(mp)
         # Skipping the rotations of zero vectors (the usual COM at the origin, a body at rest) keeps building cheap.
         com = position + quat_rotate(quat, mp.com) if mp.com.any() else position
         angmom = (
@@ -327,9 +315,9 @@ class World:
             raise TypeError("add_static needs a shape, got None")
         position = as_vector3("position", position)
         quat = as_quaternion("orientation", orientation)
-        material = self._check_material(friction, restitution, rolling_resistance)
+        material = as_material(friction, restitution, rolling_resistance)
         name = self._check_name(name)
-        group, mask = _check_filter("collision_group", collision_group), _check_filter("collision_mask", collision_mask)
+        group, mask = as_filter("collision_group", collision_group), as_filter("collision_mask", collision_mask)
         items = _shape_items(shape, material, group, mask)
         index = self._builder.add_body(None, items, name=name)
         return self._append(index, position, quat, np.zeros(3), np.zeros(3))
@@ -421,14 +409,6 @@ class World:
     def joints(self) -> list[Joint]:
         """Every joint, in the order they were added."""
         return list(self._joints)
-
-    @staticmethod
-    def _check_material(friction, restitution, rolling_resistance) -> tuple[float, float, float]:
-        friction = as_float("friction", friction, nonnegative=True)
-        restitution = as_float("restitution", restitution, nonnegative=True)
-        if restitution > 1.0:
-            raise ValueError(f"restitution must be in [0, 1], got {restitution!r}")
-        return friction, restitution, as_float("rolling_resistance", rolling_resistance, nonnegative=True)
 
     def _check_name(self, name) -> str | None:
         if name is None:
@@ -550,9 +530,10 @@ class World:
                 raise TypeError(f"unknown solver setting {key!r}; settings: {sorted(current)}")
             if key == "substeps":
                 if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)):
-                    raise TypeError(f"substeps must be an integer >= 1, got {value!r} ({type(value).__name__})")
-                if value < 1:
-                    raise ValueError(f"substeps must be an integer >= 1, got {value!r}")
+                    kind = type(value).__name__
+                    raise TypeError(f"substeps must be an integer >= 1 (at most {MAX_COUNT}), got {value!r} ({kind})")
+                if not 1 <= value <= MAX_COUNT:
+                    raise ValueError(f"substeps must be an integer >= 1 (at most {MAX_COUNT}), got {value!r}")
                 current[key] = int(value)
             elif key == "sleep":
                 if not isinstance(value, (bool, np.bool_)):
@@ -587,9 +568,10 @@ class World:
         """Advance one step of ``dt`` seconds. Applied forces act during this step only.
 
         Raises:
-            SimulationError: the step produced a non-finite value; the world keeps its state from before.
+            SimulationError: the step produced a non-finite value; the world keeps its state from before, and the
+                loads applied for the step are dropped (so that the next step can succeed).
         """
-        dt = as_float("dt", dt, positive=True)
+        dt = as_step("dt", dt, self._state.time)
         failing = self._controlled_step(dt)
         if failing >= 0:
             raise self._simulation_error(failing)
@@ -638,12 +620,9 @@ class World:
         good state and the error's ``trajectory`` holds the frames recorded up to it.
         """
         duration = as_float("duration", duration, positive=True)
-        dt = as_float("dt", dt, positive=True)
-        if isinstance(record_every, bool) or not isinstance(record_every, (int, np.integer)) or record_every < 1:
-            raise ValueError(f"record_every must be an integer >= 1, got {record_every!r}")
-        n_steps = round(duration / dt)
-        if n_steps < 1:
-            raise ValueError(f"duration={duration!r} is shorter than one step of dt={dt!r}")
+        dt = as_step("dt", dt, self._state.time)
+        record_every = as_count("record_every", record_every)
+        n_steps = step_count(duration, dt)
         self._sync()
         t0, initial = self._state.time, self._state.copy()
         recording = Trajectory.allocate_recording(self._state.body_count, n_steps // record_every)
@@ -742,8 +721,7 @@ class World:
             np.zeros((5, 3)), speeds,
         )  # fmt: skip
         _advance_clock(state, dt, steps)
-        if steps > 0:
-            inputs.clear()
+        inputs.clear()  # as simulate_steps: used, or dropped with a failed first step
         error = self._flight_failed(table, flight, speeds, self._next_step_time(dt)) if flight >= 0 else None
         return steps, failing, error
 
@@ -771,7 +749,7 @@ class World:
         step = self._state.step_count
         return SimulationError(
             f"body {label} became non-finite (NaN or Inf) in step {step} (t = {self._state.time:.6g} s); "
-            "the world keeps its state from before that step",
+            "the world keeps its state from before that step (the loads applied for it are dropped)",
             body=name if name is not None else row,
             step=step,
         )
@@ -824,16 +802,13 @@ class World:
         from .geometry.raycast import raycast_shapes
 
         origin = as_vector3("origin", origin)
-        direction = as_vector3("direction", direction)
-        length = float(np.linalg.norm(direction))
-        if length == 0.0:
-            raise ValueError(f"direction must be non-zero, got {direction.tolist()}")
+        direction = as_unit_vector3("direction", direction, tiny=0.0)
         if not (isinstance(max_distance, float) and max_distance == math.inf):
             max_distance = as_float("max_distance", max_distance, nonnegative=True)
-        mask = _check_filter("mask", mask)
+        mask = as_filter("mask", mask)
         model, state = self.model, self._state
         shape, distance, point, normal = raycast_shapes(
-            model.geometry, state.body_pos, state.body_quat, origin, direction / length, max_distance,
+            model.geometry, state.body_pos, state.body_quat, origin, direction, max_distance,
             model.shape_group, np.uint32(mask),
         )  # fmt: skip
         if shape < 0:
@@ -861,7 +836,7 @@ class World:
         shape = _check_query_shape(shape)
         position = as_vector3("position", position)
         quat = as_quaternion("orientation", orientation)
-        mask = _check_filter("mask", mask)
+        mask = as_filter("mask", mask)
         model, state = self.model, self._state
         rows = overlapping_shapes(
             model.geometry, state.body_pos, state.body_quat, model.shape_group, mask, shape, position, quat

@@ -201,10 +201,10 @@ def test_a_plane_or_mesh_has_no_mass_properties_of_its_own(shape):
 @pytest.mark.parametrize(
     ("settings", "error", "message"),
     [
-        ({"substeps": 0}, ValueError, r"substeps must be an integer >= 1, got 0"),
-        ({"substeps": -3}, ValueError, r"substeps must be an integer >= 1, got -3"),
-        ({"substeps": 2.5}, TypeError, r"substeps must be an integer >= 1, got 2.5 \(float\)"),
-        ({"substeps": True}, TypeError, r"substeps must be an integer >= 1, got True \(bool\)"),
+        ({"substeps": 0}, ValueError, r"substeps must be an integer >= 1 \(at most \d+\), got 0"),
+        ({"substeps": -3}, ValueError, r"substeps must be an integer >= 1 \(at most \d+\), got -3"),
+        ({"substeps": 2.5}, TypeError, r"substeps must be an integer >= 1 \(at most \d+\), got 2.5 \(float\)"),
+        ({"substeps": True}, TypeError, r"substeps must be an integer >= 1 \(at most \d+\), got True \(bool\)"),
         ({"contact_hertz": -1}, ValueError, r"contact_hertz must be > 0, got -1.0"),
         ({"contact_hertz": 0.0}, ValueError, r"contact_hertz must be > 0, got 0.0"),
         ({"contact_hertz": NAN}, ValueError, r"contact_hertz must be finite, got nan"),
@@ -229,7 +229,7 @@ def test_set_solver_refuses_unknown_and_bad_settings_and_keeps_the_old_ones():
     with pytest.raises(ValueError, match=r"contact_hertz must be > 0, got -1.0"):
         world.set_solver(contact_hertz=-1)
     # Nothing of a refused call is applied, not even the good settings given beside the bad one.
-    with pytest.raises(ValueError, match=r"substeps must be an integer >= 1, got 0"):
+    with pytest.raises(ValueError, match=r"substeps must be an integer >= 1 \(at most \d+\), got 0"):
         world.set_solver(contact_hertz=30.0, substeps=0)
     assert world.solver.substeps == 4
     assert world.solver.contact_hertz == tumble.World().solver.contact_hertz
@@ -320,7 +320,7 @@ def test_a_refused_call_leaves_the_world_unchanged_and_steppable(call):
 def test_a_force_whose_moment_overflows_is_refused():
     world = tumble.World()
     body = world.add_body(tumble.Sphere(0.1), mass=1.0)
-    with pytest.raises(ValueError, match="has a moment about the centre of mass that overflows"):
+    with pytest.raises(ValueError, match="has the moment .* which overflows"):
         body.apply_force((1e300, 0.0, 0.0), point=(0.0, 1e300, 0.0))
     assert not world.inputs.body_torque.any()
 

@@ -176,7 +176,7 @@ def test_writer_appends_every_nth_step_and_skips_repeats(tmp_path):
 
 def test_writer_refuses_bad_input(tmp_path):
     world = _pile()
-    with pytest.raises(ValueError, match="every must be an integer >= 1"):
+    with pytest.raises(ValueError, match="every must be an integer from 1 to"):
         recording.TrajectoryWriter(tmp_path / "a.h5", world, every=0)
     with pytest.raises(ValueError, match="scene must be a dict or a JSON string"):
         recording.TrajectoryWriter(tmp_path / "a.h5", world, scene="{not json")

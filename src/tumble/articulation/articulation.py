@@ -13,7 +13,18 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .._validate import _show, as_array, as_float, as_quaternion, as_vector3, mass_or_density
+from .._validate import (
+    _show,
+    as_array,
+    as_count,
+    as_float,
+    as_quaternion,
+    as_step,
+    as_vector3,
+    mass_or_density,
+    require_memory,
+    step_count,
+)
 from ..errors import SimulationError
 from ..mass import MassProperties
 from ..rotation import quat_from_rotvec, quat_multiply, quat_to_matrix
@@ -446,7 +457,7 @@ class Articulation:
         (n, 6) world-frame rows (force [N] at each link's centre of mass, torque [N m]) held over the step. On a
         :class:`~tumble.SimulationError` the state stays as it was.
         """
-        dt = as_float("dt", dt, positive=True)
+        dt = as_step("dt", dt, self._time)
         method = _check_integrator(integrator)
         c = self._compiled if self._compiled is not None else self._compile()
         tau = c.zero_v if tau is None else self._check_vector("tau", tau, self.nv)
@@ -468,18 +479,16 @@ class Articulation:
         keeps its last good state and the error's ``trajectory`` holds the frames recorded up to it.
         """
         duration = as_float("duration", duration, positive=True)
-        dt = as_float("dt", dt, positive=True)
+        dt = as_step("dt", dt, self._time)
         method = _check_integrator(integrator)
-        if isinstance(record_every, bool) or not isinstance(record_every, (int, np.integer)) or record_every < 1:
-            raise ValueError(f"record_every must be an integer >= 1, got {_show(record_every)}")
-        steps = round(duration / dt)
-        if steps < 1:
-            raise ValueError(f"duration={duration!r} is shorter than one step of dt={dt!r}")
+        every = as_count("record_every", record_every)
+        steps = step_count(duration, dt)
+        frames = steps // every + 1
+        require_memory(8 * frames * (self.nq + self.nv + 1), f"recording {frames} frames",
+                       "record fewer frames (a larger record_every, a shorter duration)")  # fmt: skip
         c = self._compile()
         tau = c.zero_v if tau is None else self._check_vector("tau", tau, self.nv)
         forces = c.zero_external if external is None else self._check_external(external)
-        every = int(record_every)
-        frames = steps // every + 1
         nq, nv = self.nq, self.nv
         record = np.empty((frames, nq + nv + 1))
         done, status, where = articulation_kernel(c.ints, c.reals, self._q, self._qd, tau, forces,
