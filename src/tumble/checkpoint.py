@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import math
 import os
 import zipfile
 from pathlib import Path
@@ -165,8 +166,11 @@ class _Decoder:
             raise self._fail(f"unknown shape type {spec.get('type')!r}")
         params, vertices, faces = self(spec["params"]), self(spec["vertices"]), self(spec["faces"])
         params = np.asarray(params, dtype=np.float64)
-        if params.shape != (4,):
-            raise self._fail(f"{cls.__name__} params of shape {params.shape}")
+        if params.shape != (4,) or not np.isfinite(params).all():
+            raise self._fail(f"{cls.__name__} params {params.tolist()}")
+        volume = spec["volume"]
+        if isinstance(volume, bool) or not isinstance(volume, (int, float)) or volume < 0.0:  # a plane's is inf, a surface's NaN
+            raise self._fail(f"{cls.__name__} volume {volume!r}")
         has_mesh = cls in (_shapes.ConvexHull, _shapes.TriMesh)
         if (vertices is not None) != has_mesh or (faces is not None) != has_mesh:
             raise self._fail(f"{cls.__name__} with vertices {vertices is not None} and faces {faces is not None}")
@@ -174,6 +178,8 @@ class _Decoder:
             vertices, faces = np.asarray(vertices, np.float64), np.asarray(faces, np.int64)
             if vertices.ndim != 2 or vertices.shape[1] != 3 or faces.ndim != 2 or faces.shape[1] != 3:
                 raise self._fail(f"{cls.__name__} vertices {vertices.shape} and faces {faces.shape}")
+            if not np.isfinite(vertices).all():
+                raise self._fail(f"{cls.__name__} vertices that are not finite")
             if faces.size and (faces.min() < 0 or faces.max() >= len(vertices)):
                 raise self._fail(f"{cls.__name__} face indices outside 0..{len(vertices) - 1}")
         return _shapes._rebuild(cls, params, vertices, faces, float(spec["volume"]))
@@ -316,6 +322,8 @@ def _check_values(builder: ModelBuilder, state: State, inputs: Inputs, source: s
     check("state", _require_unit_quaternions, "body_quat", state.body_quat)
     if not isinstance(state.step_count, int) or isinstance(state.step_count, bool) or state.step_count < 0:
         problems.append(f"state: step_count {state.step_count!r}")
+    if not isinstance(state.time, float) or not math.isfinite(state.time):
+        problems.append(f"state: time {state.time!r}")
     for name in ("body_force", "body_torque"):
         check("inputs", _require_numbers, name, getattr(inputs, name))
     if problems:
@@ -331,7 +339,7 @@ def _require_numbers(name: str, value, nonnegative: bool = False, allow_inf: boo
     if nonnegative:
         bad |= array < 0
     if bad.any():
-        raise ValueError(f"{name} holds {array[bad].ravel()[0]!r}")
+        raise ValueError(f"{name} holds {array[bad].ravel()[0].item()!r}")
 
 
 def _require_unit_quaternions(name: str, value) -> None:

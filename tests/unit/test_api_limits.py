@@ -4,7 +4,10 @@ a refused call or a failed step never leaves the world stuck; damaged files and 
 
 from __future__ import annotations
 
+import json
 import os
+import random
+import re
 import subprocess
 import sys
 import warnings
@@ -256,3 +259,151 @@ def test_an_articulation_refuses_absurd_steps_and_durations():
     with pytest.raises(ValueError, match=r"recording 1000000000001 frames would take .* TiB"):
         art.simulate(1e9, 1e-3)
     art.simulate(0.01, 1e-3)
+
+
+# --- damaged files -----------------------------------------------------------------------------------------------
+
+
+def _saved_world(tmp_path):
+    world = tumble.World()
+    world.add_static(tumble.Plane(), name="ground")
+    a = world.add_body(tumble.Box((0.2, 0.2, 0.2)), mass=1.0, position=(0, 0, 0.3), name="a")
+    b = world.add_body(tumble.Sphere(0.1), mass=1.0, position=(0.5, 0, 0.3), name="b")
+    world.add_joint(tumble.HingeJoint(a, b, (0.25, 0, 0.3), (0, 1, 0), lower=-1, upper=1))
+    world.simulate(0.05, 0.01)
+    path = tmp_path / "world.npz"
+    world.save(path)
+    with np.load(path, allow_pickle=False) as data:
+        members = {k: data[k] for k in data.files}
+    return json.loads(str(members.pop("manifest"))), members
+
+
+def _tree_paths(node, prefix=()):
+    """Every path into a JSON tree, the root's children first."""
+    if isinstance(node, dict):
+        items = node.items()
+    elif isinstance(node, list):
+        items = enumerate(node)
+    else:
+        return
+    for key, child in items:
+        yield (*prefix, key)
+        yield from _tree_paths(child, (*prefix, key))
+
+
+_DAMAGE = ("delete", None, "x", -1, 0, [], {}, 1e308, float("nan"), True, [1, 2])
+
+
+def _load_damaged(manifest, members, path, damage, out) -> None:
+    edited = json.loads(json.dumps(manifest))
+    parent = edited
+    for key in path[:-1]:
+        parent = parent[key]
+    if damage == "delete":
+        del parent[path[-1]]
+    else:
+        parent[path[-1]] = damage
+    np.savez(out, manifest=np.array(json.dumps(edited)), **members)
+    try:
+        world = tumble.World.load(out)
+    except ValueError as error:
+        assert str(error).startswith(repr(str(out))), (path, damage, error)
+        return
+    try:  # a file the checks let through holds values the API accepts: the world steps, or says why it cannot
+        world.step(0.01)
+    except (tumble.SimulationError, ValueError) as error:
+        assert "checkpoint" not in str(error), (path, damage, error)
+
+
+@pytest.mark.parametrize("sample", [pytest.param(400, id="sampled"), pytest.param(None, marks=pytest.mark.slow,
+                                                                                   id="every")])  # fmt: skip
+def test_a_damaged_checkpoint_gives_one_error_naming_the_file(tmp_path, sample):
+    manifest, members = _saved_world(tmp_path)
+    cases = [(path, damage) for path in _tree_paths(manifest) for damage in _DAMAGE]
+    if sample is not None:
+        cases = random.Random(22).sample(cases, sample)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # values of 1e308 overflow in the bounds of a step
+        for path, damage in cases:
+            _load_damaged(manifest, members, path, damage, tmp_path / "damaged.npz")
+
+
+@pytest.mark.parametrize(
+    ("damage", "match"),
+    [
+        (lambda m: m.pop("shapes"), r"is not a valid tumble checkpoint: no entry 'shapes'"),
+        (lambda m: m.__setitem__("params", [1, 2]), r"params is list, expected Params"),
+        (lambda m: m["params"]["fields"]["solver"]["fields"].__setitem__("substeps", 0), r"substeps must be an "
+         "integer"),
+        (lambda m: m["state"]["fields"]["body_quat"]["$small"][0].__setitem__(0, 7.0), r"body_quat holds a quaternion "
+         "of norm"),
+        (lambda m: m["state"]["fields"].__setitem__("time", "soon"), r"state: time 'soon'"),
+        (lambda m: m["builder"]["fields"]["rows"][1]["fields"].__setitem__("linear_damping", -1.0), r"body 1: "
+         "linear_damping holds -1.0"),
+        (lambda m: m["builder"]["fields"]["joints"][0]["fields"].__setitem__("kind", 9), r"joint 0: 9 is not a valid "
+         "JointKind"),
+    ],
+)  # fmt: skip
+def test_damaged_checkpoints_say_what_is_wrong(tmp_path, damage, match):
+    manifest, members = _saved_world(tmp_path)
+    damage(manifest)
+    out = tmp_path / "damaged.npz"
+    np.savez(out, manifest=np.array(json.dumps(manifest)), **members)
+    with pytest.raises(ValueError, match=rf"^{re.escape(repr(str(out)))} .*{match}"):
+        tumble.World.load(out)
+
+
+def test_a_cut_or_reshaped_checkpoint_member_is_refused(tmp_path):
+    manifest, members = _saved_world(tmp_path)
+    out = tmp_path / "damaged.npz"
+    np.savez(out, manifest=np.array(json.dumps(manifest)), **members)
+    data = out.read_bytes()
+    for cut in (len(data) // 2, 100, 10):
+        (tmp_path / "cut.npz").write_bytes(data[:cut])
+        with pytest.raises(ValueError, match=r"cut.npz' is not a readable tumble checkpoint"):
+            tumble.World.load(tmp_path / "cut.npz")
+    for key in members:
+        np.savez(out, manifest=np.array(json.dumps(manifest)), **{**members, key: members[key].ravel()[:-1]})
+        with pytest.raises(ValueError, match=r"damaged.npz' is not a (valid|consistent) tumble checkpoint"):
+            tumble.World.load(out)
+
+
+def _trajectory_file(tmp_path, suffix: str):
+    world, _ = _world()
+    path = tmp_path / f"run{suffix}"
+    world.simulate(0.1, 0.01).save(path)
+    return path
+
+
+@pytest.mark.parametrize("suffix", [".npz", ".h5"])
+def test_a_cut_trajectory_file_gives_one_error_naming_it(tmp_path, suffix):
+    path = _trajectory_file(tmp_path, suffix)
+    data = path.read_bytes()
+    cut = tmp_path / f"cut{suffix}"
+    for size in (len(data) // 2, 600, 20):
+        cut.write_bytes(data[:size])
+        with pytest.raises(ValueError, match=rf"^'{re.escape(str(cut))}' is not a (readable|valid) tumble trajectory"):
+            tumble.Trajectory.load(cut)
+
+
+def test_files_that_are_not_trajectories_are_named_as_such(tmp_path):
+    junk = tmp_path / "junk.npz"
+    junk.write_bytes(b"\x80\x04 not a zip, not a pickle either")
+    with pytest.raises(ValueError, match=r"junk.npz' is not a readable tumble trajectory: not an .npz or HDF5 file "
+                       r"of numbers \(tumble never reads pickled Python objects\)"):  # fmt: skip
+        tumble.Trajectory.load(junk)
+    path = _trajectory_file(tmp_path, ".npz")
+    with np.load(path, allow_pickle=False) as data:
+        members = {k: data[k] for k in data.files}
+    for key, value, match in (
+        ("position", np.array([{"x": 1}], dtype=object), "never reads pickled Python objects"),
+        ("position", members["position"][:, :1], r"position has shape \(11, 1, 3\), expected \(11, 2, 3\)"),
+        ("time", members["time"][:-1], r"position has shape \(11, 2, 3\), expected \(10, 2, 3\)"),
+        ("orientation", members["orientation"].astype(np.complex128), "orientation holds complex128 values"),
+        ("gravity", np.zeros(4), r"gravity has shape \(4,\), expected \(3,\)"),
+        ("metadata_json", np.array("[1, 2]"), "metadata is a JSON list, not an object"),
+        ("metadata_json", np.array("{not json"), "JSONDecodeError"),
+    ):
+        np.savez(tmp_path / "bad.npz", **{**members, key: value})
+        with pytest.raises(ValueError, match=rf"bad.npz' is not a (readable|valid) tumble trajectory: .*{match}"):
+            tumble.Trajectory.load(tmp_path / "bad.npz")

@@ -26,7 +26,7 @@ from typing import NamedTuple
 import numpy as np
 
 from .._jit import inline, kernel
-from .._validate import as_float
+from .._validate import MAX_COUNT, as_float
 from ..geometry.manifold import MAX_POINTS
 from ..math3d import (
     add,
@@ -86,8 +86,13 @@ class SolverSettings(NamedTuple):
         contacts of ``contact_hertz`` (at least 8 substeps per contact period: 8 at 60 Hz with the default 60 Hz
         contacts, 16 at 30 Hz, 1 from 480 Hz on)."""
         dt = as_float("dt", dt, positive=True)
-        needed = math.ceil(dt * SUBSTEP_RATE_PER_CONTACT_HERTZ * self.contact_hertz * (1.0 - 1e-12))
-        return max(self.substeps, needed)
+        needed = dt * SUBSTEP_RATE_PER_CONTACT_HERTZ * self.contact_hertz * (1.0 - 1e-12)
+        if not needed <= MAX_COUNT:
+            raise ValueError(
+                f"contact_hertz={self.contact_hertz!r} at dt={dt!r} needs {needed:.3g} substeps per step, more than "
+                f"{MAX_COUNT}: lower contact_hertz or dt"
+            )
+        return max(self.substeps, math.ceil(needed))
 
 
 class ContactRows(NamedTuple):
