@@ -283,8 +283,10 @@ def test_progress_bar_through_the_recorder_callback(folder, tmp_path):
     assert len(trajectory) == 61 and trajectory.metadata["status"] == "complete"
 
 
-@pytest.mark.skipif(not hasattr(signal, "SIGINT") or sys.platform == "win32", reason="needs POSIX SIGINT")
-def test_sigint_stops_the_run_and_keeps_the_file_readable(folder):
+@pytest.mark.skipif(not hasattr(signal, "SIGTERM") or sys.platform == "win32", reason="needs POSIX signals")
+@pytest.mark.parametrize(("stop", "status", "said"), [("SIGINT", 130, "interrupted at t"),
+                                                      ("SIGTERM", 143, "terminated (SIGTERM) at t")])  # fmt: skip
+def test_a_signal_stops_the_run_and_keeps_the_file_readable(folder, stop, status, said):
     out = folder / "interrupted.h5"
     command = [sys.executable, "-m", "tumble", "run", str(folder / "small.toml"), "--out", str(out),
                "--dt", "1e-4", "--duration", "1000", "--quiet"]  # fmt: skip
@@ -299,13 +301,13 @@ def test_sigint_stops_the_run_and_keeps_the_file_readable(folder):
         # The file grows in several writes before its first frame (HDF5's own structures): a signal sent at the
         # first growth found 0 or 1 frames in 1 run of 15. A second lets chunks of 2048 steps pile up.
         time.sleep(1.0)
-        process.send_signal(signal.SIGINT)
+        process.send_signal(getattr(signal, stop))
         stdout, stderr = process.communicate(timeout=60)
     finally:
         if process.poll() is None:
             process.kill()
-    assert process.returncode == 130, (stdout, stderr)
-    assert "interrupted" in stderr and "Traceback" not in stderr
+    assert process.returncode == status, (stdout, stderr)
+    assert said in stderr and "status 'interrupted'" in stderr and "Traceback" not in stderr
     trajectory = Trajectory.load(out)
     assert trajectory.metadata["status"] == "interrupted"
     assert 1 < len(trajectory) and trajectory.time[-1] < 1000
@@ -348,7 +350,12 @@ def test_a_ctrl_c_that_python_drops_is_raised_again_at_the_next_chunk():
         Finalised()
         with pytest.raises(KeyboardInterrupt):
             latch.check()
+    with _InterruptLatch() as latch:
+        with pytest.raises(KeyboardInterrupt) as caught:
+            latch._handle(signal.SIGTERM, sys._getframe())
+        assert type(caught.value).__name__ == "_Terminated"
     assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
+    assert signal.getsignal(signal.SIGTERM) is signal.SIG_DFL
 
 
 def test_info_lists_the_first_rows_of_a_big_scene_and_all_with_all(tmp_path):

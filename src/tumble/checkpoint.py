@@ -168,8 +168,8 @@ class _Decoder:
         params = np.asarray(params, dtype=np.float64)
         if params.shape != (4,) or not np.isfinite(params).all():
             raise self._fail(f"{cls.__name__} params {params.tolist()}")
-        volume = spec["volume"]
-        if isinstance(volume, bool) or not isinstance(volume, (int, float)) or volume < 0.0:  # a plane's is inf, a surface's NaN
+        volume = spec["volume"]  # >= 0; a plane's is inf, a surface mesh's NaN
+        if isinstance(volume, bool) or not isinstance(volume, (int, float)) or volume < 0.0:
             raise self._fail(f"{cls.__name__} volume {volume!r}")
         has_mesh = cls in (_shapes.ConvexHull, _shapes.TriMesh)
         if (vertices is not None) != has_mesh or (faces is not None) != has_mesh:

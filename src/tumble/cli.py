@@ -13,7 +13,8 @@
 
 Exit status: 0 done; 1 the simulation failed (a :class:`~tumble.SimulationError`: the message names the body and
 the step, and what was recorded up to the last good step is kept); 2 bad input (a scene file that does not
-validate, a missing file, a bad option value: one line on stderr, no traceback); 130 interrupted (Ctrl-C).
+validate, a missing file, a bad option value: one line on stderr, no traceback); 130 interrupted (Ctrl-C); 143
+terminated (SIGTERM, which stops a run as Ctrl-C does).
 ``python -m tumble`` is the same command. See ``docs/cli.md``.
 """
 
@@ -34,12 +35,13 @@ from pathlib import Path
 
 from ._validate import MAX_COUNT, MAX_STEPS
 
-__all__ = ["main", "EXIT_OK", "EXIT_SIMULATION", "EXIT_BAD_INPUT", "EXIT_INTERRUPTED"]
+__all__ = ["main", "EXIT_OK", "EXIT_SIMULATION", "EXIT_BAD_INPUT", "EXIT_INTERRUPTED", "EXIT_TERMINATED"]
 
 EXIT_OK = 0
 EXIT_SIMULATION = 1
 EXIT_BAD_INPUT = 2
 EXIT_INTERRUPTED = 130
+EXIT_TERMINATED = 143  # 128 + SIGTERM (15), as a shell reports a process that a signal ended
 
 TRAJECTORY_SUFFIXES = (".h5", ".hdf5", ".he5", ".npz")
 PLOT_KINDS = ("energy", "momentum", "omega", "paths", "flight")
@@ -259,34 +261,43 @@ class _Progress:
             self._bar.update(self._task, completed=steps, t=world.time)
 
 
+class _Terminated(KeyboardInterrupt):
+    """SIGTERM (``kill``, a job scheduler's end of time), raised where Ctrl-C would be, so that it stops a run the
+    same way: the recording closed with status 'interrupted', a message, and :data:`EXIT_TERMINATED`."""
+
+
+def _stop_signals() -> list[int]:
+    return [getattr(signal, name) for name in ("SIGINT", "SIGTERM") if hasattr(signal, name)]
+
+
 class _InterruptLatch:
-    """Ctrl-C that cannot be lost. Python raises ``KeyboardInterrupt`` wherever the main thread is, and drops it,
-    with a traceback on stderr, when that is a weakref callback or a ``__del__`` ("Exception ignored in ..."): the
-    run then went on. The latch raises it at once unless it landed in one of those, and remembers it, so that the
-    next chunk's callback raises it in any case."""
+    """Ctrl-C and SIGTERM that cannot be lost. Python raises ``KeyboardInterrupt`` wherever the main thread is, and
+    drops it, with a traceback on stderr, when that is a weakref callback or a ``__del__`` ("Exception ignored in
+    ..."): the run then went on. The latch raises it at once unless it landed in one of those, and remembers it, so
+    that the next chunk's callback raises it in any case. SIGTERM raises :class:`_Terminated`, a KeyboardInterrupt."""
 
     def __init__(self) -> None:
-        self.requested = False
-        self._previous = None
+        self.requested: int | None = None  # the signal received
+        self._previous: dict[int, object] = {}
 
     def __enter__(self):
-        if hasattr(signal, "SIGINT"):
-            self._previous = signal.signal(signal.SIGINT, self._handle)
+        for number in _stop_signals():
+            self._previous[number] = signal.signal(number, self._handle)
         return self
 
     def __exit__(self, *exc) -> None:
-        if self._previous is not None:
-            signal.signal(signal.SIGINT, self._previous)
+        for number, previous in self._previous.items():
+            signal.signal(number, previous)
 
     def _handle(self, signum, frame) -> None:
-        self.requested = True
+        self.requested = signum
         if frame is not None and (frame.f_code.co_name == "__del__" or frame.f_code.co_filename == weakref.__file__):
             return  # Python would drop it here: the next chunk raises it
-        raise KeyboardInterrupt
+        self.check()
 
     def check(self) -> None:
-        if self.requested:
-            raise KeyboardInterrupt
+        if self.requested is not None:
+            raise _Terminated if self.requested == getattr(signal, "SIGTERM", None) else KeyboardInterrupt
 
 
 def _chunk_frames(body_count: int, frames: int, hdf5: bool) -> int:
@@ -354,12 +365,13 @@ def _cmd_run(args) -> int:
         except SimulationError as error:
             failure = error
             trajectory = getattr(error, "trajectory", None)
-        except KeyboardInterrupt:
+        except KeyboardInterrupt as interrupt:
             done = world.step_count - start_step
-            _note(f"interrupted at t = {world.time:.6g} s, after {done} of {steps} steps")
+            how = "terminated (SIGTERM)" if isinstance(interrupt, _Terminated) else "interrupted"
+            _note(f"{how} at t = {world.time:.6g} s, after {done} of {steps} steps")
             if out_path is not None:
                 _note(f"{out_path}: {_frames_kept(out_path)} (status 'interrupted')")
-            return EXIT_INTERRUPTED
+            return EXIT_TERMINATED if isinstance(interrupt, _Terminated) else EXIT_INTERRUPTED
         wall = time.perf_counter() - began
 
         if failure is not None:
@@ -792,7 +804,7 @@ def _version() -> str:
 def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(prog="tumble", description="tumble: rigid-body physics. Run scene files, inspect them, "
                      "replay and plot trajectories.", epilog="Exit status: 0 done, 1 simulation error, 2 bad input, "
-                     "130 interrupted. See docs/cli.md.")  # fmt: skip
+                     "130 interrupted, 143 terminated. See docs/cli.md.")  # fmt: skip
     parser.add_argument("--version", action="version", version=_version())
     commands = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
 
@@ -869,11 +881,15 @@ def main(argv: list[str] | None = None) -> int:
         if getattr(args, "handler", None) is None:
             parser.print_help()
             return EXIT_BAD_INPUT
-        return args.handler(args)
+        with _InterruptLatch():  # SIGTERM as Ctrl-C in every command (a run takes its own latch within)
+            return args.handler(args)
     except BadInput as error:
         _error(str(error))
         return EXIT_BAD_INPUT
-    except KeyboardInterrupt:
+    except KeyboardInterrupt as interrupt:
+        if isinstance(interrupt, _Terminated):
+            _note("terminated (SIGTERM)")
+            return EXIT_TERMINATED
         _note("interrupted")
         return EXIT_INTERRUPTED
     except BrokenPipeError:  # `tumble info big.toml | head`: stop quietly
