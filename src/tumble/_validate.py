@@ -20,6 +20,10 @@ __all__ = [
     "MAX_STEPS",
     "MIN_STEP",
     "as_count",
+    "as_rate",
+    "MAX_RATE",
+    "finite_result",
+    "listed",
     "as_filter",
     "as_material",
     "as_step",
@@ -146,6 +150,19 @@ def as_material(friction, restitution, rolling_resistance) -> tuple[float, float
     return friction, restitution, as_float("rolling_resistance", rolling_resistance, nonnegative=True)
 
 
+def listed(value) -> list | None:
+    return None if value is None else np.asarray(value, dtype=float).tolist()
+
+
+def finite_result(result: np.ndarray, name: str, given, what: str) -> np.ndarray:
+    """``result``, computed from the argument ``name`` = ``given``, if finite; else a ValueError that says ``what``
+    ``given`` gave (the caller writes nothing: a refused call changes nothing)."""
+    with np.errstate(over="ignore", invalid="ignore"):
+        if np.isfinite(result).all():
+            return result
+    raise ValueError(f"{name}={listed(given)} {what} {listed(result)}, which overflows (non-finite)")
+
+
 def as_array(name: str, value, trailing_shape: tuple[int, ...], *, batch: bool = True) -> np.ndarray:
     """A finite float64 array whose last dimensions are ``trailing_shape`` (leading batch dims allowed)."""
     if isinstance(value, (str, bytes)) or value is None:
@@ -194,6 +211,17 @@ def vector_norm(array: np.ndarray) -> np.ndarray:
 def as_vector3(name: str, value) -> np.ndarray:
     """One finite 3-vector (a fresh float64 array of shape (3,))."""
     return as_array(name, value, (3,), batch=False).copy()
+
+
+MAX_RATE = 1e300  # [rad/s] ω is stored as L = I ω and read back as I⁻¹ L: near the largest float it rounds past
+
+
+def as_rate(name: str, value) -> np.ndarray:
+    """An angular velocity [rad/s]: a finite 3-vector with components of at most :data:`MAX_RATE`."""
+    vector = as_vector3(name, value)
+    if not np.abs(vector).max() <= MAX_RATE:
+        raise ValueError(f"{name} must have components of at most {MAX_RATE:g} rad/s, got {vector.tolist()}")
+    return vector
 
 
 def as_unit_vector3(name: str, value, *, tiny: float = 1e-12) -> np.ndarray:

@@ -8,24 +8,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._validate import as_quaternion, as_vector3
+from ._validate import as_quaternion, as_rate, as_vector3, finite_result, listed
 from .dynamics.joint_solver import LOWER, MAX_MOTOR, MOTOR_SPEED, TARGET, UPPER, JointKind
 from .rotation import quat_rotate, quat_to_matrix
 
 __all__ = ["Body", "Joint"]
-
-
-def _listed(value) -> list | None:
-    return None if value is None else np.asarray(value, dtype=float).tolist()
-
-
-def _finite(result: np.ndarray, name: str, given, what: str) -> np.ndarray:
-    """``result``, computed from the argument ``name`` = ``given``, if finite; else a ValueError that says ``what``
-    ``given`` gave (the caller writes nothing: a refused call changes nothing)."""
-    with np.errstate(over="ignore", invalid="ignore"):
-        if np.isfinite(result).all():
-            return result
-    raise ValueError(f"{name}={_listed(given)} {what} {_listed(result)}, which overflows (non-finite)")
 
 
 class Body:
@@ -91,7 +78,7 @@ class Body:
         com, quat, _, _ = self._row()
         with np.errstate(over="ignore", invalid="ignore"):
             com_position = value + quat_rotate(quat, self._mass()[1])
-        com[:] = _finite(com_position, "position", value, "puts the centre of mass at")
+        com[:] = finite_result(com_position, "position", value, "puts the centre of mass at")
 
     @property
     def orientation(self) -> np.ndarray:
@@ -138,11 +125,11 @@ class Body:
 
     @angular_velocity.setter
     def angular_velocity(self, value) -> None:
-        value = as_vector3("angular_velocity", value)
+        value = as_rate("angular_velocity", value)
         self._require_dynamic("angular_velocity")
         with np.errstate(over="ignore", invalid="ignore"):
             momentum = self.inertia_world @ value
-        momentum = _finite(momentum, "angular_velocity", value, "gives the angular momentum")
+        momentum = finite_result(momentum, "angular_velocity", value, "gives the angular momentum")
         self._row()[3][:] = momentum
 
     @property
@@ -208,7 +195,7 @@ class Body:
         lever = self._lever(point)
         with np.errstate(over="ignore", invalid="ignore"):
             moment = np.cross(lever, force)
-        moment = _finite(moment, "force", force, f"at point {_listed(point)} has the moment")
+        moment = finite_result(moment, "force", force, f"at point {listed(point)} has the moment")
         self._require_dynamic("apply_force")
         self._add_loads("apply_force", force, moment)
 
@@ -221,7 +208,7 @@ class Body:
                                                                              "N m")):  # fmt: skip
             if not np.isfinite(total).all():
                 raise ValueError(
-                    f"{what}: adding {_listed(force if unit == 'N' else torque)} to the {_listed(pending)} {unit} "
+                    f"{what}: adding {listed(force if unit == 'N' else torque)} to the {listed(pending)} {unit} "
                     f"already applied to body {self.name or i!r} for the next step overflows (non-finite)"
                 )
         inputs.body_force[i], inputs.body_torque[i] = total_force, total_torque
@@ -278,9 +265,9 @@ class Body:
         with np.errstate(over="ignore", invalid="ignore"):
             velocity, momentum = linvel + impulse * inv_mass, angmom + np.cross(lever, impulse)
             omega = r @ (self._mass()[3] @ (r.T @ momentum))
-        velocity = _finite(velocity, "impulse", impulse, f"on a body of {self.mass:g} kg gives the velocity")
-        _finite(momentum, "impulse", impulse, f"at point {_listed(point)} gives the angular momentum")
-        _finite(omega, "impulse", impulse, "gives the angular velocity")
+        velocity = finite_result(velocity, "impulse", impulse, f"on a body of {self.mass:g} kg gives the velocity")
+        finite_result(momentum, "impulse", impulse, f"at point {listed(point)} gives the angular momentum")
+        finite_result(omega, "impulse", impulse, "gives the angular velocity")
         linvel[:], angmom[:] = velocity, momentum
 
     def __eq__(self, other) -> bool:

@@ -17,8 +17,11 @@ mass, so its products of inertia carry the minus sign (``I_xy = -∫ x y dm``).
 
 from __future__ import annotations
 
+import functools
+import inspect
 import math
 import numbers
+import sys
 
 import numpy as np
 
@@ -217,8 +220,13 @@ class MassProperties:
     def scaled_to(self, mass) -> MassProperties:
         """The same shape with total mass ``mass`` [kg]: the inertia scales with the mass."""
         new_mass = as_float("mass", mass, positive=True)
-        scale = new_mass / self._mass
-        return MassProperties._trusted(new_mass, self._com, self._inertia * scale, self._principal_moments() * scale)
+        with np.errstate(over="ignore", under="ignore", invalid="ignore"):
+            scale = new_mass / self._mass
+            inertia, moments = self._inertia * scale, self._principal_moments() * scale
+        if not (math.isfinite(scale) and np.isfinite(inertia).all()):
+            raise ValueError(f"mass={new_mass!r} for a body of {self._mass!r} kg at unit density scales its inertia "
+                             f"out of float range (by {scale!r})")  # fmt: skip
+        return MassProperties._trusted(new_mass, self._com, inertia, moments)
 
     # --- composites ----------------------------------------------------------------------------------
 
@@ -264,30 +272,54 @@ class MassProperties:
 # --- constructors --------------------------------------------------------------------------------------
 
 
+class _OutOfRange(ValueError):
+    """Sizes, mass or density whose volume, mass or moments leave float range; :func:`_named_arguments` adds the
+    call's arguments to the message."""
+
+
+def _named_arguments(function):
+    """``function`` (a primitive's mass properties), whose out-of-range errors name the call and its arguments."""
+
+    @functools.wraps(function)
+    def named(*args, **kwargs):
+        try:
+            return function(*args, **kwargs)
+        except _OutOfRange as error:
+            bound = inspect.signature(function).bind(*args, **kwargs)
+            given = ", ".join(f"{k}={v!r}" for k, v in bound.arguments.items() if v is not None)
+            raise ValueError(f"{function.__name__}({given}): {error}") from None
+
+    return named
+
+
 def _total_mass(mass, density, measure: float) -> float:
     """The mass from ``mass=`` or ``density=`` times ``measure`` (a volume, or an area for shells).
 
     Raises:
-        ValueError: sizes so small or so large that ``measure`` is 0 or not finite (the mass would be spread over
-            nothing, or the moments overflow).
+        _OutOfRange: sizes so small or so large that ``measure`` is not a normal, finite float (the mass would be
+            spread over nothing, 1/V overflows, or the moments do), or a density times it that overflows.
     """
     kind, value = mass_or_density(mass, density)
-    if not 0.0 < measure < math.inf:
-        raise ValueError(f"the sizes give a volume of {measure!r}: too {'small' if measure == 0.0 else 'large'} for a "
-                         "float; give sizes between about 1e-100 and 1e100 m")  # fmt: skip
-    return value if kind == "mass" else value * measure
+    if not sys.float_info.min <= measure < math.inf:  # a subnormal volume has lost its digits: 1/V overflows
+        raise _OutOfRange(f"the sizes give a volume of {measure!r}: too {'small' if measure < 1.0 else 'large'} for "
+                          "a float; give sizes between about 1e-100 and 1e100 m")  # fmt: skip
+    total = value if kind == "mass" else value * measure
+    if not sys.float_info.min <= total < math.inf:
+        raise _OutOfRange(f"density times volume gives a mass of {total!r}, out of float range")
+    return total
 
 
 def _diagonal(mass: float, moments, com=(0.0, 0.0, 0.0)) -> MassProperties:
-    """The primitives' formulas give a valid tensor for valid sizes, so only an overflow or underflow of the mass
-    or the moments is looked for (by the checked constructor, which then raises); bodies are built by the
-    hundred thousand, and this is on their way."""
-    inertia = np.diag(np.asarray(moments, dtype=np.float64))
-    if math.isfinite(mass) and mass > 0.0 and np.isfinite(inertia).all() and (inertia >= 0.0).all():
-        return MassProperties._trusted(mass, np.asarray(com, dtype=np.float64), inertia)
-    return MassProperties(mass, com, inertia)
+    """The primitives' formulas give a valid tensor for valid sizes, so only an overflow or underflow of the
+    moments is looked for; bodies are built by the hundred thousand, and this is on their way."""
+    with np.errstate(over="ignore", under="ignore"):
+        inertia = np.diag(np.asarray(moments, dtype=np.float64))
+    if not np.isfinite(inertia).all():
+        raise _OutOfRange(f"the moments of inertia {np.diag(inertia).tolist()} overflow: give a smaller mass or size")
+    return MassProperties._trusted(mass, np.asarray(com, dtype=np.float64), inertia)
 
 
+@_named_arguments
 def solid_sphere(radius, *, mass=None, density=None) -> MassProperties:
     """A solid ball centred at the origin: ``I = 2/5 m r² E`` (course deck 002, "Inertia of Primitive
     Shapes").
@@ -301,6 +333,7 @@ def solid_sphere(radius, *, mass=None, density=None) -> MassProperties:
     return _diagonal(m, [0.4 * m * r * r] * 3)
 
 
+@_named_arguments
 def hollow_sphere(radius, *, mass=None, density=None) -> MassProperties:
     """A thin spherical shell centred at the origin: ``I = 2/3 m r² E`` (course deck 002).
 
@@ -313,6 +346,7 @@ def hollow_sphere(radius, *, mass=None, density=None) -> MassProperties:
     return _diagonal(m, [2.0 / 3.0 * m * r * r] * 3)
 
 
+@_named_arguments
 def solid_ellipsoid(a, b, c, *, mass=None, density=None) -> MassProperties:
     """A solid ellipsoid with semi-axes ``a, b, c`` along x, y, z, centred at the origin.
 
@@ -332,6 +366,7 @@ def _positive_extents(extents) -> np.ndarray:
     return sizes
 
 
+@_named_arguments
 def box(extents, *, mass=None, density=None) -> MassProperties:
     """A solid box with FULL edge lengths ``extents = (x, y, z)`` [m], centred at the origin.
 
@@ -342,6 +377,7 @@ def box(extents, *, mass=None, density=None) -> MassProperties:
     return _diagonal(m, [m / 12.0 * (y * y + z * z), m / 12.0 * (x * x + z * z), m / 12.0 * (x * x + y * y)])
 
 
+@_named_arguments
 def solid_cylinder(radius, height, *, mass=None, density=None) -> MassProperties:
     """A solid cylinder with axis z, centred at the origin (course deck 002).
 
@@ -354,6 +390,7 @@ def solid_cylinder(radius, height, *, mass=None, density=None) -> MassProperties
     return _diagonal(m, [side, side, 0.5 * m * r * r])
 
 
+@_named_arguments
 def hollow_cylinder(radius, height, *, mass=None, density=None) -> MassProperties:
     """A thin open tube (no end caps) with axis z, centred at the origin (course deck 002).
 
@@ -367,6 +404,7 @@ def hollow_cylinder(radius, height, *, mass=None, density=None) -> MassPropertie
     return _diagonal(m, [side, side, m * r * r])
 
 
+@_named_arguments
 def capsule(radius, length, *, mass=None, density=None) -> MassProperties:
     """A solid capsule: a cylinder of ``length`` along z capped by two hemispheres, centred at the origin.
 
@@ -396,6 +434,7 @@ def capsule(radius, length, *, mass=None, density=None) -> MassProperties:
     return _diagonal(m, [side, side, axial])
 
 
+@_named_arguments
 def cone(radius, height, *, mass=None, density=None) -> MassProperties:
     """A solid right circular cone, base disc of ``radius`` at z = 0, apex at z = ``height``.
 
@@ -551,6 +590,7 @@ def _closed_mesh_integrals(vertices, faces) -> tuple[float, np.ndarray, np.ndarr
     return volume, centroid, second
 
 
+@_named_arguments
 def mesh(vertices, faces, *, mass=None, density=None) -> MassProperties:
     """A solid bounded by a closed, outward-wound triangle mesh, by exact polyhedral integration.
 

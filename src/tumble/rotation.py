@@ -235,10 +235,15 @@ def quat_rotate(q, v) -> np.ndarray:
     q = as_array("q", q, (4,))
     v = as_array("v", v, (3,))
     q, norm = _nonzero("q", q)
+    v, scale = scaled_down(v)  # a vector of 1e300 rotates as one of 1: t must not overflow on the way
     w = q[..., 0:1]
     u = q[..., 1:]
     t = np.cross(u, v) * (2.0 / (norm * norm))[..., None]
-    return v + w * t + np.cross(u, t)
+    with np.errstate(over="ignore"):
+        rotated = (v + w * t + np.cross(u, t)) * scale[..., None]
+    if not np.isfinite(rotated).all():  # |v| within one rounding of the largest float
+        raise ValueError(f"v is too long to rotate within float range, got {_show(v * scale[..., None])}")
+    return rotated
 
 
 # --- axis-angle and rotation vectors -------------------------------------------------------------------
@@ -334,6 +339,10 @@ def quat_from_rotvec(r) -> np.ndarray:
     """
     r = as_array("r", r, (3,))
     angle = vector_norm(r)
+    if not np.isfinite(angle).all():
+        raise ValueError(
+            f"r must be rotation vectors of finite length (angle), got {_show(r)}{_where(~np.isfinite(angle))}"
+        )
     vector = _sin_half_over(angle)[..., None] * r
     return _stack(np.cos(0.5 * angle), *np.moveaxis(vector, -1, 0))
 

@@ -294,7 +294,8 @@ def _problems(arrays: dict, names: list[str], metadata) -> list[str]:
     if names and len(names) != bodies:
         problems.append(f"{len(names)} body names for {bodies} bodies")
     for name, channel in arrays.get("channels", {}).items():
-        if channel.dtype.kind not in "fiu" or channel.ndim < 1 or channel.shape[0] != frames:
+        # A run that failed before the channels' first sample holds fewer of them than frames, never more.
+        if channel.dtype.kind not in "fiu" or channel.ndim < 1 or channel.shape[0] > frames:
             problems.append(f"channel {name!r} is {channel.shape} {channel.dtype}, expected {frames} frames of numbers")
     if not isinstance(metadata, dict):
         problems.append(f"metadata is a JSON {type(metadata).__name__}, not an object")

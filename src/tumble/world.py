@@ -22,9 +22,11 @@ from ._validate import (
     as_float,
     as_material,
     as_quaternion,
+    as_rate,
     as_step,
     as_unit_vector3,
     as_vector3,
+    finite_result,
     mass_or_density,
     step_count,
 )
@@ -57,6 +59,15 @@ _ORIGIN, _NO_ROTATION = (0.0, 0.0, 0.0), (1.0, 0.0, 0.0, 0.0)
 
 def _vector_or_origin(name: str, value) -> np.ndarray:
     return np.zeros(3) if value is _ORIGIN else as_vector3(name, value)
+
+
+def _world_apply(tensor: np.ndarray, quat: np.ndarray, vector: np.ndarray) -> np.ndarray:
+    """``R T Rᵀ v`` for one body, inf where it overflows (the caller refuses it by the argument's name)."""
+    with np.errstate(over="ignore", invalid="ignore"):
+        try:
+            return diagnostics.world_tensor_apply(tensor[None], quat[None], vector[None])[0]
+        except ValueError:  # quat_rotate refused the overflowed T Rᵀv
+            return np.full(3, np.inf)
 
 
 def _check_integrator(integrator) -> str:
@@ -273,7 +284,7 @@ class World:
         position = _vector_or_origin("position", position)
         quat = _IDENTITY.copy() if orientation is _NO_ROTATION else as_quaternion("orientation", orientation)
         velocity = _vector_or_origin("velocity", velocity)
-        angular_velocity = _vector_or_origin("angular_velocity", angular_velocity)
+        angular_velocity = np.zeros(3) if angular_velocity is _ORIGIN else as_rate("angular_velocity", angular_velocity)
         material = as_material(friction, restitution, rolling_resistance)
         linear_damping = as_float("linear_damping", linear_damping, nonnegative=True)
         angular_damping = as_float("angular_damping", angular_damping, nonnegative=True)
@@ -286,12 +297,11 @@ class World:
             mp = _body_mass_properties(items, mass, density, inertia)
         require_invertible(mp)
         # Skipping the rotations of zero vectors (the usual COM at the origin, a body at rest) keeps building cheap.
-        com = position + quat_rotate(quat, mp.com) if mp.com.any() else position
-        angmom = (
-            diagnostics.world_tensor_apply(mp.inertia[None], quat[None], angular_velocity[None])[0]
-            if angular_velocity.any()
-            else np.zeros(3)
-        )
+        with np.errstate(over="ignore", invalid="ignore"):
+            com = position + quat_rotate(quat, mp.com) if mp.com.any() else position
+        finite_result(com, "position", position, "puts the centre of mass at")
+        angmom = _world_apply(mp.inertia, quat, angular_velocity) if angular_velocity.any() else np.zeros(3)
+        finite_result(angmom, "angular_velocity", angular_velocity, "gives the angular momentum")
         index = self._builder.add_body(
             mp, items, linear_damping=linear_damping, angular_damping=angular_damping, name=name
         )
@@ -813,6 +823,11 @@ class World:
         )  # fmt: skip
         if shape < 0:
             return None
+        if not (math.isfinite(distance) and np.isfinite(point).all()):
+            raise ValueError(
+                f"the ray from origin={origin.tolist()} along direction={direction.tolist()} meets a shape outside "
+                "float range"
+            )
         body = self._bodies[int(model.shape_body[shape])]
         return RayHit(body, int(shape), float(distance), np.array(point), np.array(normal))
 
