@@ -185,27 +185,29 @@ def as_array(name: str, value, trailing_shape: tuple[int, ...], *, batch: bool =
 _SQUARES_SAFE = (1e-150, 1e150)
 
 
-def scaled_down(array: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """``(array / s, s)`` with one scale ``s`` per vector of the last axis: 1 where the squares of the vector's
-    components stay in float range (the vector is then returned bit for bit), its largest magnitude where they
-    would overflow or underflow, so that a norm or a direction computed from ``array / s`` stays exact to
-    round-off (the scaling of LAPACK's ``dnrm2``, applied only where it is needed)."""
+def scaled_down(array: np.ndarray) -> tuple[np.ndarray, np.ndarray | float, np.ndarray]:
+    """``(array / s, s, |array / s|)`` with one scale ``s`` per vector of the last axis: 1 where the squares of the
+    vector's components stay in float range, its largest magnitude where they would overflow or underflow, so that
+    a norm or a direction computed from ``array / s`` stays exact to round-off (the scaling of LAPACK's ``dnrm2``,
+    applied only where it is needed). When no vector needs it, ``array`` itself comes back with the float
+    ``s = 1.0``."""
     with np.errstate(over="ignore", under="ignore"):
         norm = np.linalg.norm(array, axis=-1)
     risky = ~((norm > _SQUARES_SAFE[0]) & (norm < _SQUARES_SAFE[1]))
     if not np.any(risky):
-        return array, np.ones_like(norm)
+        return array, 1.0, norm
     largest = np.max(np.abs(array), axis=-1)
     scale = np.where(risky & (largest > 0.0), largest, 1.0)
-    return array / scale[..., None], scale
+    scaled = array / scale[..., None]
+    return scaled, scale, np.linalg.norm(scaled, axis=-1)
 
 
 def vector_norm(array: np.ndarray) -> np.ndarray:
     """``|v|`` over the last axis without overflow or underflow in the squares (inf only where ``|v|`` itself
     exceeds the largest float)."""
-    scaled, scale = scaled_down(array)
+    _, scale, norm = scaled_down(array)
     with np.errstate(over="ignore"):
-        return np.linalg.norm(scaled, axis=-1) * scale
+        return norm * scale
 
 
 def as_vector3(name: str, value) -> np.ndarray:
@@ -227,8 +229,7 @@ def as_rate(name: str, value) -> np.ndarray:
 def as_unit_vector3(name: str, value, *, tiny: float = 1e-12) -> np.ndarray:
     """One finite 3-vector longer than ``tiny``, returned normalised (an axis, a normal, a direction)."""
     vector = as_vector3(name, value)
-    scaled, scale = scaled_down(vector)
-    norm = float(np.linalg.norm(scaled))
+    scaled, scale, norm = scaled_down(vector)
     if not norm * scale > tiny:
         raise ValueError(f"{name} must be a non-zero vector, got {vector.tolist()}")
     return scaled / norm
@@ -237,8 +238,7 @@ def as_unit_vector3(name: str, value, *, tiny: float = 1e-12) -> np.ndarray:
 def as_quaternion(name: str, value) -> np.ndarray:
     """One finite, non-zero quaternion ``[w, x, y, z]``, returned normalised to unit length."""
     q = as_array(name, value, (4,), batch=False)
-    scaled, scale = scaled_down(q)
-    norm = float(np.linalg.norm(scaled))
+    scaled, scale, norm = scaled_down(q)
     if norm * scale < 1e-12:
         raise ValueError(f"{name} must be a non-zero quaternion [w, x, y, z], got {_show(q)}")
     return scaled / norm

@@ -49,6 +49,7 @@ __all__ = [
 
 # A quaternion shorter than this has no meaningful direction; the same bound as ``_validate.as_quaternion``.
 _MIN_QUAT_NORM = 1e-12
+_LARGE = 1e150  # a vector with components below this rotates without scaling (|v| < 2e150)
 
 # Below this angle the series forms take over from the closed forms (whose ratios become 0/0 at zero).
 # The first neglected term is O(θ⁴) relative, i.e. below 1e-16 here: the series is exact in float64.
@@ -81,8 +82,7 @@ def _where(mask: np.ndarray) -> str:
 def _nonzero(name: str, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """``(q', |q'|)`` with ``q'`` the same rotation as ``q`` scaled where its squares would overflow
     (``_validate.scaled_down``; ``q`` itself elsewhere), refusing a (near-)zero quaternion that has no rotation."""
-    scaled, scale = scaled_down(q)
-    norm = np.linalg.norm(scaled, axis=-1)
+    scaled, scale, norm = scaled_down(q)
     with np.errstate(over="ignore"):
         bad = norm * scale < _MIN_QUAT_NORM
     if np.any(bad):
@@ -235,12 +235,17 @@ def quat_rotate(q, v) -> np.ndarray:
     q = as_array("q", q, (4,))
     v = as_array("v", v, (3,))
     q, norm = _nonzero("q", q)
-    v, scale = scaled_down(v)  # a vector of 1e300 rotates as one of 1: t must not overflow on the way
+    scale = 1.0
+    if v.size and not -_LARGE < v.min() <= v.max() < _LARGE:  # two passes, no copy: the usual vectors skip this
+        v, scale, _ = scaled_down(v)  # a vector of 1e300 rotates as one of 1: t must not overflow on the way
     w = q[..., 0:1]
     u = q[..., 1:]
     t = np.cross(u, v) * (2.0 / (norm * norm))[..., None]
+    rotated = v + w * t + np.cross(u, t)
+    if isinstance(scale, float):  # nothing scaled: |t| <= 2 |v| / |q| <= 4e162 stays inside float range
+        return rotated
     with np.errstate(over="ignore"):
-        rotated = (v + w * t + np.cross(u, t)) * scale[..., None]
+        rotated *= scale[..., None]
     if not np.isfinite(rotated).all():  # |v| within one rounding of the largest float
         raise ValueError(f"v is too long to rotate within float range, got {_show(v * scale[..., None])}")
     return rotated
@@ -280,8 +285,7 @@ def quat_from_axis_angle(axis, angle) -> np.ndarray:
     """
     axis = as_array("axis", axis, (3,))
     angle = as_array("angle", angle, ())
-    scaled, _ = scaled_down(axis)
-    length = np.linalg.norm(scaled, axis=-1)
+    scaled, _, length = scaled_down(axis)
     bad = length == 0.0
     if np.any(bad):
         raise ValueError(f"axis must be a non-zero vector, got {_show(axis)}{_where(bad)}")
