@@ -220,13 +220,13 @@ class MassProperties:
     def scaled_to(self, mass) -> MassProperties:
         """The same shape with total mass ``mass`` [kg]: the inertia scales with the mass."""
         new_mass = as_float("mass", mass, positive=True)
-        with np.errstate(over="ignore", under="ignore", invalid="ignore"):
-            scale = new_mass / self._mass
-            inertia, moments = self._inertia * scale, self._principal_moments() * scale
-        if not (math.isfinite(scale) and np.isfinite(inertia).all()):
+        scale = new_mass / self._mass
+        moments = self._principal_moments()
+        # No entry of a positive semi-definite tensor exceeds its largest moment: this bounds them all.
+        if not (math.isfinite(scale) and scale * float(moments[-1]) < math.inf):
             raise ValueError(f"mass={new_mass!r} for a body of {self._mass!r} kg at unit density scales its inertia "
                              f"out of float range (by {scale!r})")  # fmt: skip
-        return MassProperties._trusted(new_mass, self._com, inertia, moments)
+        return MassProperties._trusted(new_mass, self._com, self._inertia * scale, moments * scale)
 
     # --- composites ----------------------------------------------------------------------------------
 

@@ -297,11 +297,14 @@ class World:
             mp = _body_mass_properties(items, mass, density, inertia)
         require_invertible(mp)
         # Skipping the rotations of zero vectors (the usual COM at the origin, a body at rest) keeps building cheap.
-        with np.errstate(over="ignore", invalid="ignore"):
-            com = position + quat_rotate(quat, mp.com) if mp.com.any() else position
-        finite_result(com, "position", position, "puts the centre of mass at")
-        angmom = _world_apply(mp.inertia, quat, angular_velocity) if angular_velocity.any() else np.zeros(3)
-        finite_result(angmom, "angular_velocity", angular_velocity, "gives the angular momentum")
+        com, angmom = position, np.zeros(3)
+        if mp.com.any():
+            with np.errstate(over="ignore", invalid="ignore"):
+                com = finite_result(position + quat_rotate(quat, mp.com), "position", position,
+                                    "puts the centre of mass at")  # fmt: skip
+        if angular_velocity.any():
+            angmom = _world_apply(mp.inertia, quat, angular_velocity)
+            finite_result(angmom, "angular_velocity", angular_velocity, "gives the angular momentum")
         index = self._builder.add_body(
             mp, items, linear_damping=linear_damping, angular_damping=angular_damping, name=name
         )
