@@ -102,24 +102,33 @@ def mat_vec(m, v):
 
 
 @inline
+def _cramer33(m, b, c0, det):
+    """``M⁻¹ b`` from the first column's cofactors ``c0`` and the determinant ``det``."""
+    inv_det = 1.0 / det
+    x0 = (b[0] * c0[0] + b[1] * (m[2] * m[7] - m[1] * m[8]) + b[2] * (m[1] * m[5] - m[2] * m[4])) * inv_det
+    x1 = (b[0] * c0[1] + b[1] * (m[0] * m[8] - m[2] * m[6]) + b[2] * (m[2] * m[3] - m[0] * m[5])) * inv_det
+    x2 = (b[0] * c0[2] + b[1] * (m[1] * m[6] - m[0] * m[7]) + b[2] * (m[0] * m[4] - m[1] * m[3])) * inv_det
+    return (x0, x1, x2)
+
+
+@inline
 def solve33(m, b):
     """``M⁻¹ b`` by Cramer's rule (``M`` well conditioned: an inertia-like matrix).
 
-    ``M`` and ``b`` are first scaled by the power of two nearest ``1 / max |M_ij|`` (exact: it changes no bit of the
-    answer), so that the determinant, a product of three entries, neither overflows nor underflows for the
-    inertia of a body of 1e-100 or 1e300 kg."""
+    Where the determinant, a product of three entries, leaves the safe range (the inertia of a body of 1e-100 or
+    1e300 kg), ``M`` and ``b`` are first scaled by the power of two nearest ``1 / max |M_ij|``: exact, so the answer
+    is the one the unscaled formula gives wherever that one is finite."""
+    c0 = (m[4] * m[8] - m[5] * m[7], m[5] * m[6] - m[3] * m[8], m[3] * m[7] - m[4] * m[6])
+    det = m[0] * c0[0] + m[1] * c0[1] + m[2] * c0[2]
+    if 1e-290 < abs(det) < 1e290:
+        return _cramer33(m, b, c0, det)
     largest = max(abs(m[0]), abs(m[1]), abs(m[2]), abs(m[3]), abs(m[4]), abs(m[5]), abs(m[6]), abs(m[7]), abs(m[8]))
     scale = math.ldexp(1.0, -math.frexp(largest)[1]) if 0.0 < largest < math.inf else 1.0
     m = (m[0] * scale, m[1] * scale, m[2] * scale, m[3] * scale, m[4] * scale, m[5] * scale, m[6] * scale,
          m[7] * scale, m[8] * scale)  # fmt: skip
     b = (b[0] * scale, b[1] * scale, b[2] * scale)
     c0 = (m[4] * m[8] - m[5] * m[7], m[5] * m[6] - m[3] * m[8], m[3] * m[7] - m[4] * m[6])
-    det = m[0] * c0[0] + m[1] * c0[1] + m[2] * c0[2]
-    inv_det = 1.0 / det
-    x0 = (b[0] * c0[0] + b[1] * (m[2] * m[7] - m[1] * m[8]) + b[2] * (m[1] * m[5] - m[2] * m[4])) * inv_det
-    x1 = (b[0] * c0[1] + b[1] * (m[0] * m[8] - m[2] * m[6]) + b[2] * (m[2] * m[3] - m[0] * m[5])) * inv_det
-    x2 = (b[0] * c0[2] + b[1] * (m[1] * m[6] - m[0] * m[7]) + b[2] * (m[0] * m[4] - m[1] * m[3])) * inv_det
-    return (x0, x1, x2)
+    return _cramer33(m, b, c0, m[0] * c0[0] + m[1] * c0[1] + m[2] * c0[2])
 
 
 # --- quaternions -------------------------------------------------------------------------------------

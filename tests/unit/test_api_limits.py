@@ -413,3 +413,24 @@ def test_files_that_are_not_trajectories_are_named_as_such(tmp_path):
         np.savez(tmp_path / "bad.npz", **{**members, key: value})
         with pytest.raises(ValueError, match=rf"bad.npz' is not a (readable|valid) tumble trajectory: .*{match}"):
             tumble.Trajectory.load(tmp_path / "bad.npz")
+
+
+@pytest.mark.parametrize("body_mass", [1e-300, 1e-150, 1e150, 1e300])
+def test_bodies_of_extreme_mass_step_with_contacts(body_mass):
+    # The implicit gyroscopic step solves with the inertia's determinant, a product of three moments: it is scaled
+    # by a power of two where it would leave float range (math3d.solve33).
+    def dropped(mass):
+        world = tumble.World()
+        world.add_static(tumble.Plane())
+        body = world.add_body(tumble.Box((0.1, 0.2, 0.3)), mass=mass, position=(0, 0, 0.16), angular_velocity=(1, 2, 3))
+        world.simulate(0.05, 1e-3)
+        return body
+
+    body, reference = dropped(body_mass), dropped(1.0)
+    assert np.isfinite([*body.position, *body.angular_velocity]).all()
+    assert 0.04 < body.position[2] < 0.17  # resting on or falling to the plane, not through it
+    if 1e-200 < body_mass < 1e200:
+        # Mass scales out of rigid-body motion under gravity and contact: the same motion to round-off. (At 1e±300
+        # the solver's products of masses leave float range: the motion is still finite, no longer the same.)
+        np.testing.assert_allclose(body.position, reference.position, atol=1e-9)
+        np.testing.assert_allclose(body.angular_velocity, reference.angular_velocity, rtol=1e-7, atol=1e-9)
