@@ -377,3 +377,29 @@ def test_info_lists_the_first_rows_of_a_big_scene_and_all_with_all(tmp_path):
     full = tumble_cli("info", scene, "--all")
     assert full.returncode == 0, full.stderr
     assert " b129 " in full.stdout and "more bodies" not in full.stdout and "more joints" not in full.stdout
+
+
+def test_the_bar_says_that_kernels_compile_until_the_first_chunk():
+    from io import StringIO
+
+    from numba.core import event
+    from rich.console import Console
+
+    from tumble import cli
+
+    progress = cli._Progress(Console(file=StringIO(), force_terminal=True, width=160), 100, 0, 1.0, enabled=True)
+    stage = lambda: progress._bar.tasks[0].fields["stage"]  # noqa: E731
+    with progress:
+        assert stage() == "simulating"
+        for _ in range(3):
+            with event.trigger_event("numba:compile", data={"dispatcher": None, "args": (), "return_type": None}):
+                pass
+        assert stage() == "compiling kernels (first run only)… 3 functions"
+        world = tumble.World()
+        world.add_body(tumble.Sphere(0.1), mass=1.0)
+        world.step(0.01)
+        progress(world, None)  # the first chunk is done: simulating
+        assert stage() == "simulating" and progress.compiled == 3
+    with event.trigger_event("numba:compile", data={"dispatcher": None, "args": (), "return_type": None}):
+        pass
+    assert progress.compiled == 3  # the listener went with the bar

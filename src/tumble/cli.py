@@ -33,6 +33,8 @@ import time
 import weakref
 from pathlib import Path
 
+from numba.core import event as numba_event  # numba is loaded with tumble anyway
+
 from ._validate import MAX_COUNT, MAX_STEPS
 
 __all__ = ["main", "EXIT_OK", "EXIT_SIMULATION", "EXIT_BAD_INPUT", "EXIT_INTERRUPTED", "EXIT_TERMINATED"]
@@ -220,20 +222,29 @@ def _prepare_output(path: Path) -> Path:
 # --- tumble run -------------------------------------------------------------------------------------------------
 
 
+SIMULATING = "simulating"
+COMPILING = "compiling kernels (first run only)…"
+
+
 class _Progress:
     """A rich progress bar fed by ``recording.record``'s callback; it also times the chunks, so that the steps/s
-    of the summary leave out the first chunk (which pays for loading the compiled kernels)."""
+    of the summary leave out the first chunk (which pays for loading the compiled kernels).
+
+    On a first run the first chunk waits while Numba compiles the kernels (a minute or more on a fresh machine):
+    the bar's label then says so, with the count of functions compiled, from Numba's ``numba:compile`` events."""
 
     def __init__(self, console, total_steps: int, start_step: int, duration: float, enabled: bool) -> None:
         self.start_step = start_step
         self.first_chunk: tuple[float, int] | None = None  # (time.perf_counter(), steps) after the first chunk
         self.last: tuple[float, int] | None = None
+        self.compiled = 0  # functions Numba compiled while the bar was up
         self._bar = None
+        self._watch = None
         if enabled:
             from rich.progress import BarColumn, Progress, TaskProgressColumn, TextColumn, TimeRemainingColumn
 
             self._bar = Progress(
-                TextColumn("simulating"),
+                TextColumn("{task.fields[stage]}"),
                 BarColumn(),
                 TaskProgressColumn(),
                 TextColumn("t = {task.fields[t]:.3g} / {task.fields[duration]:.3g} s"),
@@ -241,16 +252,24 @@ class _Progress:
                 console=console,
                 transient=True,
             )
-            self._task = self._bar.add_task("run", total=total_steps, t=0.0, duration=duration)
+            self._task = self._bar.add_task("run", total=total_steps, t=0.0, duration=duration, stage=SIMULATING)
+            self._watch = _CompileWatch(self._compiled)
 
     def __enter__(self):
         if self._bar is not None:
+            numba_event.register("numba:compile", self._watch)
             self._bar.start()
         return self
 
     def __exit__(self, *exc) -> None:
         if self._bar is not None:
+            numba_event.unregister("numba:compile", self._watch)
             self._bar.stop()
+
+    def _compiled(self) -> None:
+        self.compiled += 1
+        if self.first_chunk is None:
+            self._bar.update(self._task, stage=f"{COMPILING} {self.compiled} functions")
 
     def __call__(self, world, writer) -> None:
         now, steps = time.perf_counter(), world.step_count - self.start_step
@@ -258,7 +277,20 @@ class _Progress:
             self.first_chunk = (now, steps)
         self.last = (now, steps)
         if self._bar is not None:
-            self._bar.update(self._task, completed=steps, t=world.time)
+            self._bar.update(self._task, completed=steps, t=world.time, stage=SIMULATING)
+
+
+class _CompileWatch(numba_event.Listener):
+    """Calls ``on_compile()`` at the end of each Numba compilation (not for a load from the cache)."""
+
+    def __init__(self, on_compile) -> None:
+        self._on_compile = on_compile
+
+    def on_start(self, event) -> None:
+        pass
+
+    def on_end(self, event) -> None:
+        self._on_compile()
 
 
 class _Terminated(KeyboardInterrupt):

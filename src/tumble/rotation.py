@@ -21,10 +21,14 @@ non-numbers raise ``TypeError``. The Numba versions used inside kernels live in 
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 from ._validate import _show, as_array, as_quaternion, scaled_down, vector_norm
+
+if TYPE_CHECKING:
+    from scipy.spatial.transform import Rotation
 
 __all__ = [
     "skew",
@@ -599,6 +603,8 @@ def to_scipy(q) -> Rotation:
     Raises:
         ValueError: a quaternion in ``q`` is zero.
     """
+    from scipy.spatial.transform import Rotation  # on first use: import tumble stays light
+
     q, _ = _nonzero("q", as_array("q", q, (4,)))
     return Rotation.from_quat(q[..., [1, 2, 3, 0]])
 
@@ -620,6 +626,8 @@ def from_scipy(rotation: Rotation) -> np.ndarray:
         >>> np.round(from_scipy(Rotation.from_rotvec([0.0, 0.0, np.pi / 2])), 6)
         array([0.707107, 0.      , 0.      , 0.707107])
     """
+    from scipy.spatial.transform import Rotation
+
     if not isinstance(rotation, Rotation):
         raise TypeError(
             f"rotation must be a scipy.spatial.transform.Rotation, got {_show(rotation)} ({type(rotation).__name__})"

@@ -27,7 +27,6 @@ import math
 from enum import IntEnum
 
 import numpy as np
-import scipy.spatial
 
 from . import mass as _mass
 from ._validate import _show, as_array, as_float, as_unit_vector3, as_vector3
@@ -421,6 +420,8 @@ class ConvexHull(Shape):
                 f"points must have shape (n, 3) with n >= 4 to span a volume, got shape {pts.shape}: {_show(pts)}"
             )
         size = _hull_extent_check(pts)
+        import scipy.spatial  # on first use: import tumble stays light
+
         try:
             hull = scipy.spatial.ConvexHull(pts)
         except scipy.spatial.QhullError as error:

@@ -19,7 +19,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy.linalg import expm, solve_continuous_lyapunov
 
 from ._validate import as_float, as_seed, as_vector3
 
@@ -120,6 +119,8 @@ class Dryden(Wind):
     def _transition(self, dt: float) -> tuple[np.ndarray, np.ndarray]:
         """``Φ = e^(A dt)`` and a square root of the exact noise covariance ``P − Φ P Φᵀ`` over ``dt``."""
         if dt not in self._transitions:
+            from scipy.linalg import expm  # SciPy loads on first use: import tumble stays light
+
             phi = expm(self._a * dt)
             self._transitions[dt] = phi, _root(self._p - phi @ self._p @ phi.T)
         return self._transitions[dt]
@@ -144,6 +145,8 @@ def _shaping_filter(longitudinal: bool, sigma: float, t: float) -> tuple[np.ndar
         a = np.array([[0.0, 1.0], [-1.0 / t**2, -2.0 / t]])
         b = np.array([[0.0], [1.0]])
         c = np.array([1.0, math.sqrt(3.0) * t])
+    from scipy.linalg import solve_continuous_lyapunov
+
     p = solve_continuous_lyapunov(a, -b @ b.T)
     c = c * sigma / math.sqrt(c @ p @ c)
     return a, c, p
