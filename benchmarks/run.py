@@ -21,6 +21,8 @@ Run from the repository root:
                  tumble against RotorPy (``benchmarks/quadrotor.py``).
 ``build``        building worlds of 1k to 100k free bodies and 1k to 10k joints (a chain, a grid) through the API
                  and from scene files, beside MuJoCo compiling the same bodies from MJCF (``benchmarks/build.py``).
+``first_run``    cold runs with an empty Numba cache: the flagship in one process and after ``tumble warmup --jobs 2``,
+                 a sphere on a plane (``benchmarks/first_run.py``; only with ``--only``, about five minutes).
 ``broad_phase``  world bounds and sort-and-sweep pairs alone, on a pile and a scatter of 1k and 5k shapes
                  (``benchmarks/broad_phase.py``; tumble only: no peer exposes its broad phase).
 
@@ -52,7 +54,7 @@ import numpy as np
 
 import tumble
 
-from . import articulation, broad_phase, build, contact, joints, peers, quadrotor
+from . import articulation, broad_phase, build, contact, first_run, joints, peers, quadrotor
 
 __all__ = [
     "BENCHMARKS",
@@ -703,8 +705,9 @@ BENCHMARKS: dict[str, Callable[[Sizes], list[dict]]] = {
     "quadrotor": quadrotor.bench_quadrotor,
     "build": build.bench_build,
     "broad_phase": broad_phase.bench_broad_phase,
+    "first_run": first_run.bench_first_run,
 }
-OPTIONAL = ("big_pyramid",)  # slow: run only when asked for with --only
+OPTIONAL = ("big_pyramid", "first_run")  # slow: run only when asked for with --only
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -260,3 +260,11 @@ def test_broad_phase_rows_for_both_worlds_and_pairs_in_the_pile():
     # 50 boxes 1 cm apart with a 2 cm margin (5 rows of 10): the bounds of every neighbour overlap, along the rows
     # (5 * 9), across them (4 * 10) and on both diagonals (2 * 4 * 9).
     assert rows[0]["pairs"] == 5 * 9 + 4 * 10 + 2 * 4 * 9
+
+
+def test_first_run_rows_with_warm_caches():
+    from benchmarks import first_run
+
+    rows = first_run.bench_first_run(run.Sizes(**{**run.QUICK.__dict__, "cold_start": False}))
+    _assert_finite_numbers(rows)
+    assert [r["case"] for r in rows] == ["sphere on a plane"] and rows[0]["run_s"] > 0

@@ -403,3 +403,24 @@ def test_the_bar_says_that_kernels_compile_until_the_first_chunk():
     with event.trigger_event("numba:compile", data={"dispatcher": None, "args": (), "return_type": None}):
         pass
     assert progress.compiled == 3  # the listener went with the bar
+
+
+def test_warmup_steps_each_scene_in_its_own_process_and_reports_failures(tmp_path, monkeypatch, capsys):
+    from tumble import cli, scene_file, warmup
+
+    shipped = {p.stem: p for p in scene_file.shipped()}
+    broken = tmp_path / "broken.toml"
+    broken.write_text("[world]\ngravity = [0, 0]\n")
+    results = warmup.warmup(2, scenes=[shipped["pendulum"], broken, shipped["flagship"]])
+    assert [r.name for r in results if r.error is None] in (["pendulum", "flagship"], ["flagship", "pendulum"])
+    (failed,) = [r for r in results if r.error is not None]
+    assert failed.name == "broken" and "gravity" in failed.error
+    monkeypatch.setattr(scene_file, "shipped", lambda: [shipped["pendulum"], shipped["dzhanibekov"]])
+    assert cli.main(["warmup", "--jobs", "1"]) == cli.EXIT_OK
+    err = capsys.readouterr().err
+    assert "2 of 2 scenes warmed" in err and "1 process at a time" in err
+    with pytest.raises(ValueError, match="jobs must be an integer >= 1, got 0"):
+        warmup.warmup(0)
+    with pytest.raises(SystemExit) as exit_info:  # argparse refuses it, with the status of bad input
+        cli.main(["warmup", "--jobs", "0"])
+    assert exit_info.value.code == cli.EXIT_BAD_INPUT

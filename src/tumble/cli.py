@@ -8,6 +8,7 @@
     tumble view TRAJ -o replay.html [--scene SCENE] [--title TEXT] [--max-frames N]
     tumble plot TRAJ [--what energy,momentum,omega,paths] [-o DIR|FILE] [--bodies NAMES]
     tumble examples [--copy DIR] [--force]
+    tumble warmup [--jobs N] [--quiet]
     tumble bench [--quick] [--only NAME]... [--csv [DIR]] [--repeat N] [--machine NAME]
     tumble --version
 
@@ -726,6 +727,26 @@ def _shipped_scenes() -> list[Path]:
     return list(scene_file.shipped())
 
 
+def _cmd_warmup(args) -> int:
+    from .warmup import default_jobs, warmup
+
+    jobs = args.jobs or default_jobs()
+    began = time.perf_counter()
+
+    def done(result, count, total) -> None:
+        if result.error is not None:
+            _error(f"warmup of {result.name} failed: {result.error}")
+        elif not args.quiet:
+            _note(f"warmed {result.name} ({count}/{total}, {result.seconds:.1f} s)")
+
+    results = warmup(jobs, on_done=done)
+    failed = [r for r in results if r.error is not None]
+    if not args.quiet or failed:
+        _note(f"{len(results) - len(failed)} of {len(results)} scenes warmed in {time.perf_counter() - began:.1f} s "
+              f"with {jobs} process{'es' if jobs > 1 else ''} at a time")  # fmt: skip
+    return EXIT_SIMULATION if failed else EXIT_OK
+
+
 def _cmd_examples(args) -> int:
     from rich.table import Table
 
@@ -890,6 +911,14 @@ def build_parser() -> argparse.ArgumentParser:
     examples.add_argument("--copy", metavar="DIR", help="copy the scene files here")
     examples.add_argument("--force", action="store_true", help="overwrite files already in DIR")
     examples.set_defaults(handler=_cmd_examples)
+
+    warm = commands.add_parser("warmup", help="compile the kernels before the first run (make install does)",
+                               description="Step every shipped scene a few times in parallel processes that share "
+                               "Numba's cache, so that later runs start at once.")  # fmt: skip
+    warm.add_argument("--jobs", "-j", type=_positive_int, metavar="N", help="processes at a time (default: one "
+                      "per core)")  # fmt: skip
+    warm.add_argument("--quiet", "-q", action="store_true", help="print only failures")
+    warm.set_defaults(handler=_cmd_warmup)
 
     bench = commands.add_parser(
         "bench",
