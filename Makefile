@@ -7,11 +7,11 @@ BROWSER_STAMP := $(VENV)/.browser
 
 .PHONY: install demo test test-slow bench lint clean
 
+# The venv, then the kernels compiled two processes at a time (tumble warmup), so that the first run starts at once.
 $(STAMP): pyproject.toml
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
 	$(PY) -m pip install --quiet -e ".[test,mesh,plot]"
-	# Compile the kernels now, two processes at a time, so that the first run starts at once (tumble warmup).
 	$(PY) -m tumble warmup --jobs 2 --quiet || echo "tumble warmup failed: the first runs will compile instead"
 	touch $(STAMP)
 
