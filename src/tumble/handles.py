@@ -47,10 +47,14 @@ class Body:
         """``(mass, com_local, inertia, inv_inertia)`` in the body frame (``World._mass_row``)."""
         return self._world._mass_row(self._index)
 
-    def _require_dynamic(self, what: str) -> None:
-        """Refuse to move a static body; wake a sleeping one (with its island), since it is about to move."""
+    def _refuse_static(self, what: str) -> None:
         if self.is_static:
             raise ValueError(f"{what}: body {self.name or self._index!r} is static and cannot move")
+
+    def _require_dynamic(self, what: str) -> None:
+        """Refuse to move a static body; wake a sleeping one (with its island), since it is about to move. A call
+        that can still refuse its values checks them before this (a refused call must not wake anything)."""
+        self._refuse_static(what)
         s = self._world._state
         if self._index < s.body_count and s.body_sleeping[self._index]:  # a body not yet stepped is awake
             island = s.body_island == s.body_island[self._index]
@@ -74,11 +78,13 @@ class Body:
     @position.setter
     def position(self, value) -> None:
         value = as_vector3("position", value)
-        self._require_dynamic("position")
+        self._refuse_static("position")
         com, quat, _, _ = self._row()
         with np.errstate(over="ignore", invalid="ignore"):
             com_position = value + quat_rotate(quat, self._mass()[1])
-        com[:] = finite_result(com_position, "position", value, "puts the centre of mass at")
+        finite_result(com_position, "position", value, "puts the centre of mass at")
+        self._require_dynamic("position")
+        com[:] = com_position
 
     @property
     def orientation(self) -> np.ndarray:
@@ -126,10 +132,11 @@ class Body:
     @angular_velocity.setter
     def angular_velocity(self, value) -> None:
         value = as_rate("angular_velocity", value)
-        self._require_dynamic("angular_velocity")
+        self._refuse_static("angular_velocity")
         with np.errstate(over="ignore", invalid="ignore"):
             momentum = self.inertia_world @ value
-        momentum = finite_result(momentum, "angular_velocity", value, "gives the angular momentum")
+        finite_result(momentum, "angular_velocity", value, "gives the angular momentum")
+        self._require_dynamic("angular_velocity")
         self._row()[3][:] = momentum
 
     @property
@@ -195,23 +202,25 @@ class Body:
         lever = self._lever(point)
         with np.errstate(over="ignore", invalid="ignore"):
             moment = np.cross(lever, force)
-        moment = finite_result(moment, "force", force, f"at point {listed(point)} has the moment")
-        self._require_dynamic("apply_force")
+        finite_result(moment, "force", force, f"at point {listed(point)} has the moment")
         self._add_loads("apply_force", force, moment)
 
     def _add_loads(self, what: str, force: np.ndarray, torque: np.ndarray) -> None:
-        """Add to the loads of the next step, both or neither (a sum that overflows is refused)."""
+        """Add to the loads of the next step, both or neither: a sum that overflows is refused before anything is
+        written or woken."""
+        self._refuse_static(what)
         inputs, i = self._world.inputs, self._index
-        with np.errstate(over="ignore", invalid="ignore"):
-            total_force, total_torque = inputs.body_force[i] + force, inputs.body_torque[i] + torque
-        for total, pending, unit in ((total_force, inputs.body_force[i], "N"), (total_torque, inputs.body_torque[i],
-                                                                             "N m")):  # fmt: skip
-            if not np.isfinite(total).all():
+        totals = []
+        for added, pending, unit in ((force, inputs.body_force[i], "N"), (torque, inputs.body_torque[i], "N m")):
+            with np.errstate(over="ignore", invalid="ignore"):
+                totals.append(pending + added)
+            if not np.isfinite(totals[-1]).all():
                 raise ValueError(
-                    f"{what}: adding {listed(force if unit == 'N' else torque)} to the {listed(pending)} {unit} "
-                    f"already applied to body {self.name or i!r} for the next step overflows (non-finite)"
+                    f"{what}: adding {listed(added)} to the {listed(pending)} {unit} already applied to body "
+                    f"{self.name or i!r} for the next step overflows (non-finite)"
                 )
-        inputs.body_force[i], inputs.body_torque[i] = total_force, total_torque
+        self._require_dynamic(what)
+        inputs.body_force[i], inputs.body_torque[i] = totals
 
     @property
     def constant_force(self) -> np.ndarray:
@@ -245,9 +254,7 @@ class Body:
         Raises:
             ValueError: its sum with the torques already applied for the step overflows (they are left as they were).
         """
-        torque = as_vector3("torque", torque)
-        self._require_dynamic("apply_torque")
-        self._add_loads("apply_torque", np.zeros(3), torque)
+        self._add_loads("apply_torque", np.zeros(3), as_vector3("torque", torque))
 
     def apply_impulse(self, impulse, point=None) -> None:
         """Change the momenta at once: ``Δp = J``, ``ΔL = r × J`` (so ``Δv = J / m``, ``Δω = I_w⁻¹ (r × J)``).
@@ -258,7 +265,7 @@ class Body:
         """
         impulse = as_vector3("impulse", impulse)
         lever = self._lever(point)
-        self._require_dynamic("apply_impulse")
+        self._refuse_static("apply_impulse")
         inv_mass = 1.0 / self.mass  # as the model's body_inv_mass holds it
         _, _, linvel, angmom = self._row()
         r = self.rotation
@@ -268,6 +275,7 @@ class Body:
         velocity = finite_result(velocity, "impulse", impulse, f"on a body of {self.mass:g} kg gives the velocity")
         finite_result(momentum, "impulse", impulse, f"at point {listed(point)} gives the angular momentum")
         finite_result(omega, "impulse", impulse, "gives the angular velocity")
+        self._require_dynamic("apply_impulse")
         linvel[:], angmom[:] = velocity, momentum
 
     def __eq__(self, other) -> bool:

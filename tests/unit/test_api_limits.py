@@ -434,3 +434,22 @@ def test_bodies_of_extreme_mass_step_with_contacts(body_mass):
         # the solver's products of masses leave float range: the motion is still finite, no longer the same.)
         np.testing.assert_allclose(body.position, reference.position, atol=1e-9)
         np.testing.assert_allclose(body.angular_velocity, reference.angular_velocity, rtol=1e-7, atol=1e-9)
+
+
+def test_a_refused_call_does_not_wake_a_sleeping_body():
+    world = tumble.World()
+    world.add_static(tumble.Plane())
+    body = world.add_body(tumble.Box((0.2, 0.2, 0.2)), mass=1e12, position=(0, 0, 0.1))
+    world.simulate(2.0, 1 / 60)
+    assert body.sleeping
+    digest = world.state.digest()
+    for refused in (
+        lambda: body.apply_impulse((1e300, 0, 0), point=(0, 1e300, 0)),
+        lambda: body.apply_force((1e300, 0, 0), point=(0, 1e300, 0)),
+        lambda: setattr(body, "angular_velocity", (1e300, 0, 0)),  # L = I ω overflows for 1e12 kg
+    ):
+        with pytest.raises(ValueError, match="overflows"):
+            refused()
+        assert body.sleeping and world.state.digest() == digest
+    body.apply_impulse((1.0, 0, 0))  # an accepted one wakes it
+    assert not body.sleeping
