@@ -32,6 +32,7 @@ import numpy as np
 from . import shapes as _shapes
 from ._validate import as_filter, as_material, as_vector3
 from .builder import JointSpec, ModelBuilder, ShapeSpec, _BodyRow
+from .dynamics.joint_solver import JointKind
 from .geometry.manifold import MAX_POINTS
 from .inputs import Inputs
 from .mass import MassProperties, require_invertible
@@ -333,7 +334,7 @@ def _check_values(builder: ModelBuilder, state: State, inputs: Inputs, source: s
 
 def _require_numbers(name: str, value, nonnegative: bool = False, allow_inf: bool = False) -> None:
     array = np.asarray(value)
-    if array.dtype.kind not in "fiu" or (array.dtype.kind == "f" and isinstance(value, bool)):
+    if array.dtype.kind not in "fiu":
         raise TypeError(f"{name} is {type(value).__name__}, not numbers")
     bad = np.isnan(array) if allow_inf else ~np.isfinite(array)
     if nonnegative:
@@ -366,8 +367,6 @@ def _require_shape(spec) -> None:
 
 
 def _require_joint(spec) -> None:
-    from .dynamics.joint_solver import JointKind
-
     if not isinstance(spec, JointSpec):
         raise TypeError(f"{type(spec).__name__}, not a joint")
     JointKind(spec.kind)

@@ -14,7 +14,9 @@ from __future__ import annotations
 import os
 import subprocess
 import sys
+import tempfile
 import time
+import typing
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -69,23 +71,25 @@ def warmup(jobs: int | None = None, *, scenes: list[Path] | None = None,
     if isinstance(jobs, bool) or not isinstance(jobs, int) or jobs < 1:
         raise ValueError(f"jobs must be an integer >= 1, got {jobs!r}")
     queue = _ordered(list(scene_file.shipped()) if scenes is None else [Path(p) for p in scenes])
-    running: list[tuple[Path, subprocess.Popen, float]] = []
+    running: list[tuple[Path, subprocess.Popen, float, typing.IO]] = []
     results: list[WarmedScene] = []
     total = len(queue)
     while queue or running:
         while queue and len(running) < jobs:
             path = queue.pop(0)
             command = [sys.executable, "-m", "tumble.warmup", str(path)]
-            process = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
-            running.append((path, process, time.perf_counter()))
+            errors = tempfile.TemporaryFile("w+")  # a file, not a pipe: a child with much to say never blocks
+            process = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=errors, text=True)
+            running.append((path, process, time.perf_counter(), errors))
         time.sleep(0.05)
         for entry in list(running):
-            path, process, started = entry
+            path, process, started, errors = entry
             if process.poll() is None:
                 continue
             running.remove(entry)
-            stderr = process.stderr.read() if process.stderr else ""
-            process.wait()
+            errors.seek(0)
+            stderr = errors.read()
+            errors.close()
             error = None if process.returncode == 0 else (stderr.strip().splitlines() or ["failed"])[-1]
             results.append(WarmedScene(path.stem, time.perf_counter() - started, error))
             if on_done is not None:

@@ -101,6 +101,17 @@ def test_mat_vec_and_solve33(results):
     np.testing.assert_allclose(out3[3], np.linalg.solve(m, v[..., None])[..., 0], rtol=1e-13, atol=1e-13)
 
 
+@pytest.mark.parametrize("exponent", [-400, -100, 100, 400])
+def test_solve33_gives_the_same_bits_for_matrices_scaled_by_powers_of_two(results, exponent):
+    # At 2^±400 the determinant (a product of three entries) leaves float range; solve33 then rescales by a power
+    # of two, which is exact: M s x = b s has the bits of M x = b. (At 2^±100 no rescaling happens at all.)
+    x, _, out3 = results
+    scale = 2.0**exponent
+    out4, scaled = np.zeros((3, N, 4)), np.zeros((5, N, 3))
+    _apply_helpers(x["quat"], x["quat_b"], x["vec"] * scale, x["vec_b"], x["mat"] * scale, x["h"], out4, scaled)
+    np.testing.assert_array_equal(scaled[3], out3[3])
+
+
 def test_cross(results):
     x, _, out3 = results
     np.testing.assert_array_equal(out3[4], np.cross(x["vec"], x["vec_b"]))
