@@ -11,11 +11,13 @@ from __future__ import annotations
 import functools
 import hashlib
 from pathlib import Path
+from types import FunctionType
 
 import numba
-from numba.core import caching
+from numba.core import caching, config, types
+from numba.core.registry import CPUDispatcher
 
-__all__ = ["kernel", "inline", "prange"]
+__all__ = ["kernel", "kernel_for", "inline", "prange"]
 
 prange = numba.prange
 _PACKAGE_DIR = Path(__file__).resolve().parent
@@ -31,8 +33,9 @@ def _leaf_of(path: Path) -> str | None:
     return parts[0] if len(parts) > 1 and parts[0] in _LEAF_PACKAGES else None
 
 
-# Modules without compiled code whose constants kernels freeze at compile time (shape and integrator codes).
-_CONSTANT_MODULES = ("shapes.py", "params.py", "geometry/manifold.py", "geometry/packing.py")
+# Modules without compiled code whose constants kernels freeze at compile time (shape and integrator codes), and
+# this one, whose options (wrappers, literal typing) shape every compiled function.
+_CONSTANT_MODULES = ("_jit.py", "shapes.py", "params.py", "geometry/manifold.py", "geometry/packing.py")
 
 
 def _compiles(path: Path) -> bool:
@@ -85,11 +88,39 @@ class _PackageUserDirLocator(_PackageStamp, caching.UserProvidedCacheLocator):
 caching.CacheImpl._locator_classes[:0] = [_PackageUserDirLocator, _PackageCacheLocator]
 
 
+class _Kernel(CPUDispatcher):
+    """A compiled function that kernels call with plain types: a constant argument (``True``, an index ``0``, a
+    shape code) does not compile a copy of the callee for its value, as Numba's literal typing would. Those copies
+    were 14–15 s of a cold flagship run (``solve_contacts(…, True)`` and ``(…, False)``, the GJK stack once for
+    ``POINT``); LLVM still folds the constant where it inlines the callee."""
+
+    def get_call_template(self, args, kws):
+        plain = {name: types.unliteral(value) for name, value in kws.items()}
+        return super().get_call_template(tuple(types.unliteral(value) for value in args), plain)
+
+
+class _Helper(_Kernel):
+    """A helper compiled without the Python-callable wrapper that every ``njit`` function gets (8–13 s of a cold
+    flagship run went to building those wrappers). Kernels call the compiled code; a call from Python runs the
+    Python source, which does the same IEEE arithmetic (``fastmath`` is off), since there is no wrapper to enter."""
+
+    def __call__(self, *args, **kwargs):
+        return self.py_func(*args, **kwargs)
+
+
+def _compiled(function, dispatcher: type, **options):
+    if config.DISABLE_JIT:
+        return function
+    compiled = dispatcher(py_func=function, locals={}, targetoptions={"nopython": True, "fastmath": False, **options})
+    compiled.enable_caching()
+    return compiled
+
+
 def kernel(function=None, *, parallel: bool = False):
-    """Compile a hot loop: ``njit(cache=True, fastmath=False, nogil=True)``."""
+    """Compile a hot loop: ``njit(cache=True, fastmath=False, nogil=True)`` (:class:`_Kernel`)."""
 
     def wrap(f):
-        return numba.njit(cache=True, fastmath=False, nogil=True, parallel=parallel)(f)
+        return _compiled(f, _Kernel, nogil=True, parallel=parallel)
 
     return wrap(function) if function is not None else wrap
 
@@ -98,6 +129,20 @@ def inline(function):
     """A small helper called from kernels (``math3d``).
 
     Compiled as its own function and left to LLVM to inline: Numba's IR-level ``inline="always"`` made the
-    contact kernels compile 30 % slower for no measurable gain at run time.
+    contact kernels compile 30 % slower for no measurable gain at run time. Without Python or C wrappers
+    (:class:`_Helper`).
     """
-    return numba.njit(cache=True, fastmath=False)(function)
+    return _compiled(function, _Helper, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+
+
+def kernel_for(template, name: str, **names):
+    """A kernel compiled from ``template``'s code with some of its global names bound to other objects: one
+    compiled copy per binding, so that a caller compiles only the copies it runs (``narrow_phase`` makes one loop
+    per pair type this way). A closure would do the same, but Numba keys its cache on the pickled closure, which
+    holds a per-process id for a compiled function: the copies would never load from the cache. Each copy is
+    named ``name``, which also names its cache files."""
+    copy = FunctionType(template.__code__, {**template.__globals__, **names}, name)
+    copy.__qualname__ = name
+    copy.__module__ = template.__module__
+    copy.__doc__ = template.__doc__
+    return kernel(copy)

@@ -272,7 +272,7 @@ def contact_step(
         substeps,
         settings.contact_push_max,
         settings.restitution_threshold,
-        model.joints,
+        model.joints if model.joint_count > 0 else None,  # None: no joint solver compiled or run
         state.joint_impulses,
         settings.joint_hertz,
         settings.joint_damping_ratio,

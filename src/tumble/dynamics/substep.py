@@ -97,22 +97,26 @@ def run_substeps(
     """The soft step's inner loop (Catto 2024): per substep integrate velocities, bounce the ball impacts of the
     substep, warm start (joints, then contacts), solve with a soft bias, integrate positions, relax without bias.
     ``inv_mass`` and ``inv_inertia_world`` are zero for bodies that do not move (static or sleeping), which the
-    solver then treats as fixed."""
+    solver then treats as fixed. ``joints`` is None in a world without joints: Numba prunes the joint solver's
+    branches before typing, so such a world never compiles it."""
     inv_h = 1.0 / h
     for k in range(substeps):
         integrate_velocities(bodies, moving, gravity, force, torque, acts, k * h, quat, linvel, angvel, h)
         resolve_impacts(rows, count, inv_mass, inv_inertia_world, pos, quat, pos0, quat0, linvel, angvel, h, threshold,
                         gravity, force, bodies.constant_force)  # fmt: skip
-        warm_start_joints(joints, joint_impulses, inv_mass, inv_inertia_world, pos, quat, linvel, angvel,
-                          joint_force_total, joint_moment_total)  # fmt: skip
+        if joints is not None:
+            warm_start_joints(joints, joint_impulses, inv_mass, inv_inertia_world, pos, quat, linvel, angvel,
+                              joint_force_total, joint_moment_total)  # fmt: skip
         warm_start_contacts(rows, count, inv_mass, inv_inertia_world, pos, quat, pos0, quat0, linvel, angvel)
-        solve_joints(joints, joint_impulses, inv_mass, inv_inertia_world, pos, quat, linvel, angvel, h, joint_hertz,
-                     joint_damping_ratio, True, joint_force_total, joint_moment_total)  # fmt: skip
+        if joints is not None:
+            solve_joints(joints, joint_impulses, inv_mass, inv_inertia_world, pos, quat, linvel, angvel, h,
+                         joint_hertz, joint_damping_ratio, True, joint_force_total, joint_moment_total)  # fmt: skip
         solve_contacts(rows, count, inv_mass, inv_inertia_world, pos, quat, pos0, quat0, linvel, angvel, inv_h,
                        push_max, True, threshold)  # fmt: skip
         integrate_positions(moving, linvel, angvel, pos, quat, h)
-        solve_joints(joints, joint_impulses, inv_mass, inv_inertia_world, pos, quat, linvel, angvel, h, joint_hertz,
-                     joint_damping_ratio, False, joint_force_total, joint_moment_total)  # fmt: skip
+        if joints is not None:
+            solve_joints(joints, joint_impulses, inv_mass, inv_inertia_world, pos, quat, linvel, angvel, h,
+                         joint_hertz, joint_damping_ratio, False, joint_force_total, joint_moment_total)  # fmt: skip
         solve_contacts(rows, count, inv_mass, inv_inertia_world, pos, quat, pos0, quat0, linvel, angvel, inv_h,
                        push_max, False, threshold)  # fmt: skip
         accumulate_impulses(rows, count)

@@ -12,7 +12,7 @@ import math
 
 import numpy as np
 
-from .._jit import kernel
+from .._jit import kernel, kernel_for
 from ..math3d import add, load3, load4, quat_mul, quat_rotate
 from .collide_convex import collide_convex_convex, collide_convex_trimesh
 from .collide_primitives import (
@@ -33,38 +33,6 @@ from .manifold import Manifolds
 __all__ = ["collide_pairs", "match_warm_start", "shape_world_pose"]
 
 SPHERE, CAPSULE, BOX, CYLINDER, HULL, PLANE, TRIMESH = 0, 1, 2, 3, 4, 5, 6
-
-
-@kernel
-def _collide_primitives(ta, tb, geom, sa, pa, qa, sb, pb, qb, margin, normal, point, separation, feature):
-    """Closed-form pairs of spheres, capsules, boxes and planes (``ta <= tb``)."""
-    if tb == PLANE:
-        if ta == SPHERE:
-            return collide_sphere_plane(geom, sa, pa, qa, sb, pb, qb, margin, normal, point, separation, feature)
-        if ta == CAPSULE:
-            return collide_capsule_plane(geom, sa, pa, qa, sb, pb, qb, margin, normal, point, separation, feature)
-        return collide_box_plane(geom, sa, pa, qa, sb, pb, qb, margin, normal, point, separation, feature)
-    if ta == SPHERE and tb == SPHERE:
-        return collide_sphere_sphere(geom, sa, pa, qa, sb, pb, qb, margin, normal, point, separation, feature)
-    if ta == SPHERE and tb == CAPSULE:
-        return collide_sphere_capsule(geom, sa, pa, qa, sb, pb, qb, margin, normal, point, separation, feature)
-    if ta == SPHERE:
-        return collide_sphere_box(geom, sa, pa, qa, sb, pb, qb, margin, normal, point, separation, feature)
-    if ta == CAPSULE and tb == CAPSULE:
-        return collide_capsule_capsule(geom, sa, pa, qa, sb, pb, qb, margin, normal, point, separation, feature)
-    if ta == CAPSULE:
-        return collide_capsule_box(geom, sa, pa, qa, sb, pb, qb, margin, normal, point, separation, feature)
-    return collide_box_box(geom, sa, pa, qa, sb, pb, qb, margin, normal, point, separation, feature)
-
-
-@kernel
-def _collide_convex(ta, tb, geom, sa, pa, qa, sb, pb, qb, margin, normal, point, separation, feature):
-    """Pairs with a cylinder or a hull: against a plane in closed form, else the general convex path."""
-    if tb == PLANE:
-        if ta == CYLINDER:
-            return collide_cylinder_plane(geom, sa, pa, qa, sb, pb, qb, margin, normal, point, separation, feature)
-        return collide_hull_plane(geom, sa, pa, qa, sb, pb, qb, margin, normal, point, separation, feature)
-    return collide_convex_convex(geom, sa, pa, qa, sb, pb, qb, margin, normal, point, separation, feature)
 
 
 @kernel
@@ -100,60 +68,60 @@ def _pair_setup(geom, body_pos, body_quat, body_linvel, body_angvel, pairs_a, pa
     return sa, sb, pa, qa, pb, qb, margin + dt * reach
 
 
-# One kernel per family (same arguments): pair k's manifold goes to row k, its point count 0 if apart.
-
-
-@kernel
-def _collide_primitive_pairs(geom, pos, quat, linvel, angvel, pairs_a, pairs_b, listed, margin, dt, manifolds):
+def _pairs_template(geom, pos, quat, linvel, angvel, pairs_a, pairs_b, listed, margin, dt, manifolds):
+    """The manifold of each listed pair ``k`` into row ``k`` (point count 0 if apart), by ``collide``, a name that
+    :func:`kernel_for` binds to one pair type's function."""
     for k in listed:
         sa, sb, pa, qa, pb, qb, mg = _pair_setup(geom, pos, quat, linvel, angvel, pairs_a, pairs_b, k, margin, dt,
                                                  manifolds)  # fmt: skip
-        manifolds.point_count[k] = _collide_primitives(geom.shape_type[sa], geom.shape_type[sb], geom, sa, pa, qa,
-                                                       sb, pb, qb, mg, manifolds.normal[k], manifolds.point[k],
-                                                       manifolds.separation[k], manifolds.feature[k])  # fmt: skip
+        rows = manifolds.normal[k], manifolds.point[k], manifolds.separation[k], manifolds.feature[k]
+        manifolds.point_count[k] = collide(geom, sa, pa, qa, sb, pb, qb, mg, *rows)  # noqa: F821 (kernel_for binds it)
 
 
-@kernel
-def _collide_convex_pairs(geom, pos, quat, linvel, angvel, pairs_a, pairs_b, listed, margin, dt, manifolds):
-    for k in listed:
-        sa, sb, pa, qa, pb, qb, mg = _pair_setup(geom, pos, quat, linvel, angvel, pairs_a, pairs_b, k, margin, dt,
-                                                 manifolds)  # fmt: skip
-        manifolds.point_count[k] = _collide_convex(geom.shape_type[sa], geom.shape_type[sb], geom, sa, pa, qa, sb,
-                                                   pb, qb, mg, manifolds.normal[k], manifolds.point[k],
-                                                   manifolds.separation[k], manifolds.feature[k])  # fmt: skip
+# One compiled loop per collision function, so that a world compiles only the pair types it has (the eleven
+# primitive pairs compiled together cost 15 s of a first run for pairs mostly absent). Pairs with a cylinder or a
+# hull that no closed form covers go to the general convex path, and any convex shape against a mesh to the mesh's.
+_COLLIDERS = (
+    collide_sphere_sphere, collide_sphere_capsule, collide_sphere_box, collide_capsule_capsule, collide_capsule_box,
+    collide_box_box, collide_sphere_plane, collide_capsule_plane, collide_box_plane, collide_cylinder_plane,
+    collide_hull_plane, collide_convex_convex, collide_convex_trimesh,
+)  # fmt: skip
+_PAIR_KERNELS = tuple(
+    kernel_for(_pairs_template, f"pairs_{collide.__name__.removeprefix('collide_')}", collide=collide)
+    for collide in _COLLIDERS
+)
 
 
-@kernel
-def _collide_mesh_pairs(geom, pos, quat, linvel, angvel, pairs_a, pairs_b, listed, margin, dt, manifolds):
-    for k in listed:
-        sa, sb, pa, qa, pb, qb, mg = _pair_setup(geom, pos, quat, linvel, angvel, pairs_a, pairs_b, k, margin, dt,
-                                                 manifolds)  # fmt: skip
-        manifolds.point_count[k] = collide_convex_trimesh(geom, sa, pa, qa, sb, pb, qb, mg, manifolds.normal[k],
-                                                          manifolds.point[k], manifolds.separation[k],
-                                                          manifolds.feature[k])  # fmt: skip
+def _collider_table() -> np.ndarray:
+    """``table[ta, tb]``: the index in ``_COLLIDERS`` of the function for a pair of types ``ta <= tb``."""
+    index = {collide.__name__: i for i, collide in enumerate(_COLLIDERS)}
+    names = ("sphere", "capsule", "box")
+    table = np.full((7, 7), index["collide_convex_convex"], dtype=np.int64)
+    for a, name_a in enumerate(names):
+        for b in range(a, len(names)):
+            table[a, b] = index[f"collide_{name_a}_{names[b]}"]
+    for a, name_a in enumerate((*names, "cylinder", "hull")):
+        table[a, PLANE] = index[f"collide_{name_a}_plane"]
+    table[:, TRIMESH] = index["collide_convex_trimesh"]
+    return table
+
+
+_COLLIDER_OF = _collider_table()
 
 
 def collide_pairs(geom, body_pos, body_quat, body_linvel, body_angvel, pairs_a, pairs_b, margin, dt, manifolds):
     """Manifolds of the candidate pairs that touch or are within their margin, in pair order; returns how many.
 
-    Pairs are split into three families (closed-form primitives, general convex, convex against a mesh) and
-    each family runs its own kernel, so that a scene compiles only the collision code it uses: the general
-    convex and mesh paths take most of the first-run compile time. Reads: geom, body poses and velocities
-    (ω world), pairs (lower shape type first). Writes: manifolds[:count].
+    The pairs of each collision function go to that function's own kernel (:data:`_PAIR_KERNELS`). Reads: geom,
+    body poses and velocities (ω world), pairs (lower shape type first). Writes: manifolds[:count].
     """
     n = pairs_a.shape[0]
     if n == 0:
         return 0
-    ta, tb = geom.shape_type[pairs_a], geom.shape_type[pairs_b]
-    mesh = tb == TRIMESH
-    convex = ~mesh & ((ta == CYLINDER) | (ta == HULL) | (tb == CYLINDER) | (tb == HULL))
-    primitive = ~mesh & ~convex
+    which = _COLLIDER_OF[geom.shape_type[pairs_a], geom.shape_type[pairs_b]]
     args = (geom, body_pos, body_quat, body_linvel, body_angvel, pairs_a, pairs_b)
-    for run, family in ((_collide_primitive_pairs, primitive), (_collide_convex_pairs, convex),
-                        (_collide_mesh_pairs, mesh)):  # fmt: skip
-        listed = np.flatnonzero(family)
-        if listed.size:
-            run(*args, listed, margin, dt, manifolds)
+    for i in np.flatnonzero(np.bincount(which, minlength=len(_COLLIDERS))):
+        _PAIR_KERNELS[i](*args, np.flatnonzero(which == i), margin, dt, manifolds)
     # Keep the pairs that made contact, in order, at the front.
     touching = np.flatnonzero(manifolds.point_count[:n] > 0)
     count = touching.size

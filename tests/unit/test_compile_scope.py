@@ -1,0 +1,109 @@
+"""What a world compiles (issue 23): only the code it runs, once per argument type.
+
+- A world without joints never types the joint solver, and the narrow phase compiles only the loops of the pair types
+  the world has (one kernel per collision function); checked in a fresh interpreter, where a kernel has signatures only
+  once something asked for it (compiled, or loaded from the cache).
+- A constant argument (``True``, an index ``0``, a shape code) does not compile a copy of the callee for its value:
+  no compiled function of tumble has a literal type in a signature after a contact world, a jointed world and a hull
+  world have stepped.
+- Helpers have no Python-callable wrapper; a call from Python runs their Python source and agrees with the compiled
+  code bit for bit.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from tumble import math3d, scenes
+from tumble._jit import kernel
+from tumble.geometry import narrow_phase
+from tumble.shapes import ShapeType
+
+COMPILED = os.environ.get("NUMBA_DISABLE_JIT", "0") != "1"
+needs_jit = pytest.mark.skipif(not COMPILED, reason="compiled code only (NUMBA_DISABLE_JIT=1)")
+
+_PROBE = """
+import json, tumble
+from tumble.dynamics import joint_solver
+from tumble.geometry import narrow_phase
+world = tumble.World()
+world.add_static(tumble.Plane())
+world.add_body(tumble.Sphere(0.1), mass=1.0, position=(0, 0, 0.105))
+world.add_body(tumble.Box((0.1, 0.1, 0.1)), mass=1.0, position=(1.0, 0, 0.1))
+for _ in range(3):
+    world.step(1 / 60)
+print(json.dumps({
+    "solve_joints": len(joint_solver.solve_joints.signatures),
+    "pairs": sorted(k.py_func.__name__ for k in narrow_phase._PAIR_KERNELS if k.signatures),
+}))
+"""
+
+
+@needs_jit
+def test_a_world_compiles_no_joint_solver_and_only_its_pair_types():
+    result = subprocess.run([sys.executable, "-c", _PROBE], capture_output=True, text=True, timeout=600)
+    assert result.returncode == 0, result.stderr[-3000:]
+    used = json.loads(result.stdout.strip().splitlines()[-1])
+    assert used == {"solve_joints": 0, "pairs": ["pairs_box_plane", "pairs_sphere_plane"]}
+
+
+def _literal_signatures() -> list[str]:
+    """Every signature of a compiled tumble function that holds a literal type (a copy for one constant)."""
+    from numba.core import types
+    from numba.core.registry import CPUDispatcher
+
+    found = []
+    for name, module in list(sys.modules.items()):
+        if not name.startswith("tumble"):
+            continue
+        for value in vars(module).values():
+            if isinstance(value, CPUDispatcher):
+                for signature in value.signatures:
+                    if any(isinstance(t, types.Literal) for t in signature):
+                        found.append(f"{value.py_func.__module__}.{value.__name__}{signature}")
+    return sorted(set(found))
+
+
+@needs_jit
+def test_no_compiled_function_is_copied_for_a_constant_argument():
+    worlds = [scenes.box_pile(count=4), scenes.pendulum_chain(links=3), scenes.mixed_pile(count=6)]
+    for world in worlds:
+        for _ in range(5):
+            world.step(1 / 60)
+    assert _literal_signatures() == []
+
+
+@kernel
+def _rotate_rows(quat, vec, out):
+    for i in range(quat.shape[0]):
+        math3d.store3(out, i, math3d.quat_rotate(math3d.load4(quat, i), math3d.load3(vec, i)))
+
+
+def test_a_helper_called_from_python_agrees_with_the_compiled_one_bit_for_bit():
+    rng = np.random.default_rng(3)
+    quat = rng.normal(size=(50, 4))
+    quat /= np.linalg.norm(quat, axis=1, keepdims=True)
+    vec = rng.normal(size=(50, 3)) * 10.0
+    compiled = np.empty_like(vec)
+    _rotate_rows(quat, vec, compiled)
+    from_python = np.array([math3d.quat_rotate(tuple(q), tuple(v)) for q, v in zip(quat, vec, strict=True)])
+    assert np.array_equal(from_python, compiled)
+
+
+def test_every_type_pair_goes_to_its_collision_function():
+    s, c, b, cyl, hull, plane, mesh = (int(t) for t in ShapeType)
+    expected = {
+        (s, s): "sphere_sphere", (s, c): "sphere_capsule", (s, b): "sphere_box", (c, c): "capsule_capsule",
+        (c, b): "capsule_box", (b, b): "box_box", (s, plane): "sphere_plane", (c, plane): "capsule_plane",
+        (b, plane): "box_plane", (cyl, plane): "cylinder_plane", (hull, plane): "hull_plane",
+        (s, cyl): "convex_convex", (b, hull): "convex_convex", (cyl, hull): "convex_convex",
+        (hull, hull): "convex_convex", (s, mesh): "convex_trimesh", (hull, mesh): "convex_trimesh",
+    }  # fmt: skip
+    for (ta, tb), name in expected.items():
+        assert narrow_phase._PAIR_KERNELS[narrow_phase._COLLIDER_OF[ta, tb]].__name__ == f"pairs_{name}"
