@@ -117,20 +117,22 @@ def _compiled(function, dispatcher: type, **options):
 
 
 def kernel(function=None, *, parallel: bool = False):
-    """Compile a hot loop: ``njit(cache=True, fastmath=False, nogil=True)`` (:class:`_Kernel`)."""
+    """Compile a function that Python calls (a stage of the step, a query): ``njit(cache=True, fastmath=False,
+    nogil=True)``, typed as :class:`_Kernel`, without the C wrapper that only a first-class function value needs.
+    A function that only compiled code calls is an :func:`inline`."""
 
     def wrap(f):
-        return _compiled(f, _Kernel, nogil=True, parallel=parallel)
+        return _compiled(f, _Kernel, nogil=True, parallel=parallel, no_cfunc_wrapper=True)
 
     return wrap(function) if function is not None else wrap
 
 
 def inline(function):
-    """A small helper called from kernels (``math3d``).
+    """Compile a function that only compiled code calls: the helpers of ``math3d``, the solvers' passes, the
+    collision routines. Without Python or C wrappers (:class:`_Helper`).
 
     Compiled as its own function and left to LLVM to inline: Numba's IR-level ``inline="always"`` made the
-    contact kernels compile 30 % slower for no measurable gain at run time. Without Python or C wrappers
-    (:class:`_Helper`).
+    contact kernels compile 30 % slower for no measurable gain at run time.
     """
     return _compiled(function, _Helper, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 

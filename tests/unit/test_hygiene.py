@@ -1,5 +1,6 @@
-"""The code base's own rules, checked on its source: no import cycles between tumble's modules, and no test that
-asserts nothing (a test that cannot fail proves nothing)."""
+"""The code base's own rules, checked on its source: no import cycles between tumble's modules, no test that
+asserts nothing (a test that cannot fail proves nothing), and no ``@kernel`` that only compiled code calls (its
+Python wrapper would cost compile time for nothing: that is an ``@inline``)."""
 
 from __future__ import annotations
 
@@ -141,3 +142,54 @@ def test_every_test_asserts_something():
         for name in _tests_that_check_nothing(path.read_text(encoding="utf-8"))
     ]
     assert silent == []
+
+
+# --- kernels that Python calls ----------------------------------------------------------------------------------
+
+
+def _decorators(function: ast.FunctionDef) -> set[str]:
+    names = set()
+    for node in function.decorator_list:
+        target = node.func if isinstance(node, ast.Call) else node
+        names.add(getattr(target, "id", getattr(target, "attr", "")))
+    return names
+
+
+def _kernels_python_never_names(sources: dict[str, str]) -> list[str]:
+    """``@kernel`` functions of ``sources`` (name -> text) that no code outside a compiled function names: a call, a
+    reference or an attribute of that name in plain Python (a module, a test, a benchmark)."""
+    trees = {name: ast.parse(text) for name, text in sources.items()}
+    kernels = {
+        f.name
+        for name, tree in trees.items()
+        if name.startswith("src/")
+        for f in ast.walk(tree)
+        if isinstance(f, ast.FunctionDef) and "kernel" in _decorators(f)
+    }
+    compiled = {"kernel", "inline"}
+    named: set[str] = set()
+    for tree in trees.values():
+        outside = [n for n in tree.body if not (isinstance(n, ast.FunctionDef) and _decorators(n) & compiled)]
+        for top in outside:
+            for node in ast.walk(top):
+                if isinstance(node, ast.FunctionDef) and _decorators(node) & compiled:
+                    continue  # a kernel nested in a test module's helper is still compiled code
+                if isinstance(node, ast.Name):
+                    named.add(node.id)
+                elif isinstance(node, ast.Attribute):
+                    named.add(node.attr)
+    return sorted(kernels - named)
+
+
+def test_the_kernel_scan_tells_a_kernel_python_calls_from_one_it_does_not():
+    sources = {
+        "src/m.py": "@kernel\ndef hot(a):\n    return helper(a)\n@kernel\ndef helper(a):\n    return a\n",
+        "tests/t.py": "def test_x():\n    assert m.hot(1)\n",
+    }
+    assert _kernels_python_never_names(sources) == ["helper"]
+
+
+def test_every_kernel_is_called_from_python():
+    paths = [*(SOURCE / "tumble").rglob("*.py"), *(REPO / "tests").rglob("*.py"), *(REPO / "benchmarks").rglob("*.py")]
+    sources = {path.relative_to(REPO).as_posix(): path.read_text(encoding="utf-8") for path in paths}
+    assert _kernels_python_never_names(sources) == []

@@ -305,7 +305,7 @@ def _store_pair(linvel, angvel, a, b, va, wa, vb, wb):
     store3(angvel, b, wb)
 
 
-@kernel
+@inline
 def warm_start_contacts(rows, count, inv_mass, inv_inertia_world, pos, quat, pos0, quat0, linvel, angvel):
     """Re-apply the accumulated impulses of every point (normal and friction).
 
@@ -331,7 +331,7 @@ def warm_start_contacts(rows, count, inv_mass, inv_inertia_world, pos, quat, pos
         _store_pair(linvel, angvel, a, b, va, wa, vb, wb)
 
 
-@kernel
+@inline
 def solve_contacts(
     rows, count, inv_mass, inv_inertia_world, pos, quat, pos0, quat0, linvel, angvel, inv_h, push_max, use_bias,
     threshold,
@@ -443,7 +443,7 @@ def _move_back(i, dv, dw, tau, inv_mass, pos, quat):
     quat[i, 0], quat[i, 1], quat[i, 2], quat[i, 3] = q[0], q[1], q[2], q[3]
 
 
-@kernel
+@inline
 def resolve_impacts(rows, count, inv_mass, inv_inertia_world, pos, quat, pos0, quat0, linvel, angvel, h, threshold,
                     gravity, force, constant_force):  # fmt: skip
     """Bounce impacts as they happen, at the time of touch within the substep, one after the other, so momentum
@@ -567,7 +567,7 @@ def apply_restitution(rows, count, inv_mass, inv_inertia_world, pos, quat, pos0,
         _store_pair(linvel, angvel, a, b, va, wa, vb, wb)
 
 
-@kernel
+@inline
 def accumulate_impulses(rows, count):
     """Add the impulses each point applied during a substep to the step's totals (for ``World.contacts``)."""
     for m in range(count):

@@ -77,7 +77,7 @@ def empty_recording(body_count: int) -> Recording:
     )  # fmt: skip
 
 
-@kernel
+@inline
 def _advance_body(i, bodies, gravity, force, torque, acts, pos, quat, linvel, angmom, rec, h, n_steps, method,
                   record_every):  # fmt: skip
     """Carry body ``i`` through ``n_steps``; return the index of the failing step, or -1.
@@ -92,7 +92,7 @@ def _advance_body(i, bodies, gravity, force, torque, acts, pos, quat, linvel, an
                        record_every)  # fmt: skip
 
 
-@kernel
+@inline
 def _body_steps(i, bodies, gravity, force, torque, acts, pos, quat, linvel, angmom, rec, h, n_steps, method,
                 record_every):  # fmt: skip
     """The steps of :func:`_advance_body`, with its actuators ``acts`` or ``None``."""

@@ -37,7 +37,7 @@ def _union(parent, a, b):
         parent[ra] = rb
 
 
-@kernel
+@inline
 def _islands(is_dynamic, shape_body, manifold_a, manifold_b, point_count, separation, count, joint_a, joint_b,
              parent):  # fmt: skip
     """Union the dynamic bodies of every touching manifold (a point with separation <= 0) and of every joint."""

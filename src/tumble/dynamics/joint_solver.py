@@ -378,7 +378,7 @@ def _swing(fa, fb):
     return math.atan2(sine, dot(na, nb)), axis
 
 
-@kernel
+@inline
 def warm_start_joints(joints, impulses, inv_mass, inv_inertia_world, pos, quat, linvel, angvel, force_total,
                       moment_total):  # fmt: skip
     """Re-apply every joint's accumulated impulses at the current poses. Writes: velocities, the totals."""
@@ -417,7 +417,7 @@ def warm_start_joints(joints, impulses, inv_mass, inv_inertia_world, pos, quat, 
         store3(moment_total, j, add(load3(moment_total, j), got_m))
 
 
-@kernel
+@inline
 def solve_joints(joints, impulses, inv_mass, inv_inertia_world, pos, quat, linvel, angvel, h, joint_hertz,
                  joint_damping_ratio, use_bias, force_total, moment_total):  # fmt: skip
     """One Gauss–Seidel pass over the joints: drive, angular rows, point rows (soft when ``use_bias``).

@@ -8,7 +8,7 @@ state is ω (world frame), which the contact impulses change directly; the step 
 
 from __future__ import annotations
 
-from .._jit import kernel
+from .._jit import inline, kernel
 from ..math3d import (
     add,
     add_scaled,
@@ -57,7 +57,7 @@ def to_angular_momentum(bodies, quat, angvel, angmom):
             store3(angmom, i, world_inertia_apply(load4(quat, i), load33(bodies.inertia_local, i), load3(angvel, i)))
 
 
-@kernel
+@inline
 def integrate_velocities(bodies, moving, gravity, force, torque, acts, tau, quat, linvel, angvel, h):
     """``v += h (g + F/m)``, implicit gyroscopic spin update, implicit damping; moving (awake dynamic) bodies. The
     actuators' and drag's loads are those of the substep's start state, ``tau`` into the step."""
@@ -79,7 +79,7 @@ def integrate_velocities(bodies, moving, gravity, force, torque, acts, tau, quat
         store3(angvel, i, quat_rotate(q, w_body))
 
 
-@kernel
+@inline
 def integrate_positions(moving, linvel, angvel, pos, quat, h):
     """``x += h v``, ``q ← q + h ½ (0, ω) ⊗ q`` renormalised; moving (awake dynamic) bodies."""
     for i in range(pos.shape[0]):

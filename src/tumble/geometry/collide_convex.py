@@ -140,7 +140,7 @@ def _clamp01(x):
     return min(max(x, 0.0), 1.0)
 
 
-@kernel
+@inline
 def _closest_segments(p0, p1, q0, q1):
     """Closest points of segments ``p0 p1`` and ``q0 q1``: minimise ``|p(s) - q(t)|`` over the unit square, clamping
     one parameter then the other (Ericson 2005, §5.1.9)."""
@@ -182,7 +182,7 @@ def _polyhedron_counts(geom, shape, face):
     return geom.shape_vertex_count[shape], fc, loops, geom.shape_edge_count[shape]
 
 
-@kernel
+@inline
 def _allocate_polyhedron(geom, shape, face):
     """Arrays for :func:`_build_polyhedron`: ``(vertex, face_normal, face_offset, face_start, face_count, face_loop,
     edge, arc_a, arc_b)``."""
@@ -214,7 +214,7 @@ def _axis(k, s):
     return (s if k == 0 else 0.0, s if k == 1 else 0.0, s if k == 2 else 0.0)
 
 
-@kernel
+@inline
 def _build_polyhedron(geom, shape, face, pos, quat, poly):
     """Fill ``poly`` (from :func:`_allocate_polyhedron`) with the shape in the world frame; return its centroid.
 
@@ -301,7 +301,7 @@ def _build_polyhedron(geom, shape, face, pos, quat, poly):
     return centroid
 
 
-@kernel
+@inline
 def _find_edge(edge, ne, lo, hi):
     """Index of edge ``(lo, hi)``: binary search (packing lists a hull's edges sorted), then a plain scan."""
     left, right = 0, ne - 1
@@ -323,7 +323,7 @@ def _find_edge(edge, ne, lo, hi):
 # --- the separating-axis test --------------------------------------------------------------------------------------
 
 
-@kernel
+@inline
 def _face_query(poly_p, poly_q, margin):
     """Best face axis of P: ``max_f min_{q in Q} (n_f · q - o_f)`` and its face (stops early past ``margin``)."""
     fnormal, foffset = poly_p[1], poly_p[2]
@@ -342,7 +342,7 @@ def _face_query(poly_p, poly_q, margin):
     return best, best_face
 
 
-@kernel
+@inline
 def _edge_query(poly_p, poly_q, margin):
     """Best edge-pair axis, over the pairs whose Gauss-map arcs cross (Gregorius 2013).
 
@@ -390,7 +390,7 @@ def _edge_query(poly_p, poly_q, margin):
 # --- clipping and reduction ----------------------------------------------------------------------------------------
 
 
-@kernel
+@inline
 def _select_four(points, seps, m, n):
     """At most four of the ``m`` candidate points: the deepest, the farthest from it, the one spanning the largest
     triangle with those two (areas measured about ``n``) and the one farthest outside that triangle. Collinear or
@@ -447,7 +447,7 @@ def _select_four(points, seps, m, n):
     return 4, k0, k1, k2, k3
 
 
-@kernel
+@inline
 def _write_four(points, seps, ids, m, n, point, separation, feature):
     """Write :func:`_select_four`'s points into the manifold outputs; return their count."""
     count, k0, k1, k2, k3 = _select_four(points, seps, m, n)
@@ -458,7 +458,7 @@ def _write_four(points, seps, ids, m, n, point, separation, feature):
     return count
 
 
-@kernel
+@inline
 def _clip_points(ref, ref_count, ref_n, inc, inc_count, inc_radius, margin, base_id, out_point, out_sep, out_id):
     """Contact points of an incident feature (polygon, segment or point core: rows ``[:inc_count]`` of ``inc``) over a
     reference face (convex polygon ``ref[:ref_count]``, either winding, outward unit normal ``ref_n``).
@@ -545,7 +545,7 @@ def _clip_points(ref, ref_count, ref_n, inc, inc_count, inc_radius, margin, base
 # --- two polyhedra ---------------------------------------------------------------------------------------------------
 
 
-@kernel
+@inline
 def _collide_polyhedra(geom, sa, fa, pa, qa, sb, fb, pb, qb, margin, out_point, out_sep, out_id):
     """Two boxes or hulls (or one and mesh triangle ``fb``): SAT, then face clipping or the edge-edge point.
 
@@ -597,7 +597,7 @@ def _collide_polyhedra(geom, sa, fa, pa, qa, sb, fb, pb, qb, margin, out_point, 
     return 1, axis
 
 
-@kernel
+@inline
 def _corner_contact(poly_ref, face_ref, poly_inc, flip, out_point, out_sep, out_id):
     """One point at the incident polyhedron's corner deepest below the reference face. Returns ``(1, normal)``."""
     vertex_i = poly_inc[0]
@@ -621,7 +621,7 @@ def _beats(separation, preferred, bias):
     return separation > preferred + FACE_BIAS_RELATIVE * abs(preferred) + bias
 
 
-@kernel
+@inline
 def _face_contact(poly_ref, face_ref, poly_inc, margin, flip, out_point, out_sep, out_id):
     """Clip the incident polyhedron's face most opposed to ``face_ref`` against it; ``flip`` when the reference is B.
     Returns ``(count, normal)``."""
@@ -681,7 +681,7 @@ def _candidate_capacity(geom, sa, fa, sb, fb):
     return _feature_capacity(geom, sa, fa) + _feature_capacity(geom, sb, fb) + 1
 
 
-@kernel
+@inline
 def _support_feature(geom, shape, face, pos, quat, d, out):
     """The feature of a shape's core farthest along the unit world direction ``d``, as world points in ``out``.
 
@@ -753,7 +753,7 @@ def _support_feature(geom, shape, face, pos, quat, d, out):
     return CAP_POINTS, n, abs(axial), 0 if s > 0.0 else 1, False
 
 
-@kernel
+@inline
 def _segment_pair(a0, a1, ra, b0, b1, rb, n, margin, out_point, out_sep, out_id):
     """Two parallel segment cores (capsules, cylinder sides): B's segment clipped to A's extent, two points."""
     u = sub(a1, a0)
@@ -782,7 +782,7 @@ def _segment_pair(a0, a1, ra, b0, b1, rb, n, margin, out_point, out_sep, out_id)
     return count
 
 
-@kernel
+@inline
 def _collide_smooth(geom, sa, fa, pa, qa, sb, fb, pb, qb, margin, out_point, out_sep, out_id):
     """A pair with a sphere, capsule or cylinder: GJK/EPA for the normal, then the features along it.
 
@@ -872,7 +872,7 @@ def collide_convex_convex(geom, shape_a, pos_a, quat_a, shape_b, pos_b, quat_b, 
     return _write_four(cand_point, cand_sep, cand_id, m, n, point, separation, feature)
 
 
-@kernel
+@inline
 def _convex_bounds_in(geom, shape, pos, quat, frame_pos, frame_quat, grow):
     """Bounds of a convex shape along the axes of another frame, grown by ``grow`` [m]: ``(lo, hi)`` in that frame."""
     whole = np.int64(-1)
@@ -969,7 +969,7 @@ def collide_convex_trimesh(geom, shape_a, pos_a, quat_a, shape_b, pos_b, quat_b,
                                 separation, feature)  # fmt: skip
 
 
-@kernel
+@inline
 def _front_face_contact(geom, shape_a, pos_a, quat_a, v0, n_face, margin, tri_point, tri_sep, tri_id):
     """One point: shape A's lowest point along the face normal ``n_face`` of a triangle through ``v0``, midway
     between it and the triangle's plane, and its signed height above the plane; 0 points past ``margin``."""
@@ -984,7 +984,7 @@ def _front_face_contact(geom, shape_a, pos_a, quat_a, v0, n_face, margin, tri_po
     return 1
 
 
-@kernel
+@inline
 def _squeeze(cand_point, cand_normal, cand_sep, cand_id, cand_face, m):
     """Keep four of the mesh's candidates (:func:`_select_four` about the deepest one's normal); return how many."""
     deepest = 0
@@ -1008,7 +1008,7 @@ def _squeeze(cand_point, cand_normal, cand_sep, cand_id, cand_face, m):
     return count
 
 
-@kernel
+@inline
 def _merge_mesh_contacts(cand_point, cand_normal, cand_sep, cand_id, cand_face, m, margin, normal, point, separation,
                          feature):  # fmt: skip
     """One manifold from the triangles' points (see the module docstring): the contact surface is the deepest face

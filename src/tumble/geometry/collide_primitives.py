@@ -149,7 +149,7 @@ def _unit(k):
     return (0.0, 0.0, 1.0)
 
 
-@kernel
+@inline
 def _from_axes(k, x, y, z):
     """The vector with ``z`` along axis ``k``, ``x`` along axis ``k+1`` and ``y`` along axis ``k+2`` (mod 3)."""
     if k == 0:
@@ -159,7 +159,7 @@ def _from_axes(k, x, y, z):
     return (x, y, z)
 
 
-@kernel
+@inline
 def _to_axes(k, p):
     """Inverse of :func:`_from_axes`: ``(p[k+1], p[k+2], p[k])``."""
     if k == 0:
@@ -169,7 +169,7 @@ def _to_axes(k, p):
     return (p[0], p[1], p[2])
 
 
-@kernel
+@inline
 def _with_component(v, k, value):
     if k == 0:
         return (value, v[1], v[2])
@@ -178,7 +178,7 @@ def _with_component(v, k, value):
     return (v[0], v[1], value)
 
 
-@kernel
+@inline
 def _box_code(c):
     """Feature code of the box feature whose centre is ``c`` (box frame): its zero components are the axes
     along which the feature extends (none: vertex, one: edge, two: face)."""
@@ -311,7 +311,7 @@ def reduce_manifold(points, normal, offset, margin):
     return 4, i0, i1, i2, i3
 
 
-@kernel
+@inline
 def _planar_distance(p, q, normal):
     """Distance from ``p`` to ``q`` within the plane of unit ``normal``."""
     d = (p[0] - q[0], p[1] - q[1], p[2] - q[2])
@@ -319,7 +319,7 @@ def _planar_distance(p, q, normal):
     return math.sqrt(max(dot(d, d) - h * h, 0.0))
 
 
-@kernel
+@inline
 def _outside_area(u, v, p, normal, orientation):
     """Twice the area of triangle ``(u, v, p)`` when ``p`` lies outside the edge ``u → v`` of a triangle wound
     with ``orientation`` about ``normal`` by more than the merge distance, else 0."""
@@ -331,7 +331,7 @@ def _outside_area(u, v, p, normal, orientation):
 # --- sphere pairs --------------------------------------------------------------------------------------------
 
 
-@kernel
+@inline
 def _ball_contact(center_a, radius_a, center_b, radius_b, fallback, margin, fid, normal, point, separation, feature):
     """One point between two balls (a sphere, or a capsule's ball at its closest segment point)."""
     d = sub(center_b, center_a)
@@ -367,7 +367,7 @@ def collide_sphere_capsule(geom, shape_a, pos_a, quat_a, shape_b, pos_b, quat_b,
                          feature)  # fmt: skip
 
 
-@kernel
+@inline
 def _nearest_face(c, half):
     """``(axis, side, gap)`` of the box face nearest to the inside point ``c`` (box frame), ``gap >= 0``."""
     best, axis, side = math.inf, 0, 1.0
@@ -408,7 +408,7 @@ def collide_sphere_box(geom, shape_a, pos_a, quat_a, shape_b, pos_b, quat_b, mar
 # --- capsule-capsule -----------------------------------------------------------------------------------------
 
 
-@kernel
+@inline
 def _closest_segments(p1, d1, h1, p2, d2, h2):
     """Parameters ``(s, t)`` of the closest points ``p1 + s d1`` and ``p2 + t d2`` of two segments given by their
     centres, unit directions and half-lengths (Ericson 2005, §5.1.9, with centred parameters). Parallel
@@ -432,7 +432,7 @@ def _closest_segments(p1, d1, h1, p2, d2, h2):
     return s, t
 
 
-@kernel
+@inline
 def _end_code(s, half_length):
     """Capsule feature code of the segment point at parameter ``s``: an end (0, 1) or in between (2)."""
     if s <= -half_length:
@@ -442,7 +442,7 @@ def _end_code(s, half_length):
     return 2
 
 
-@kernel
+@inline
 def _parallel_capsule_points(pos_a, u_a, h_a, r_a, pos_b, u_b, h_b, r_b, n, margin, point, separation, feature):
     """Two points at the ends of the stretch that nearly parallel segments share, with separations along ``n``;
     0 when the stretch is shorter than the merge distance, or an end is beyond the margin or off to the side."""
@@ -516,7 +516,7 @@ def collide_capsule_capsule(geom, shape_a, pos_a, quat_a, shape_b, pos_b, quat_b
 # --- capsule-box ---------------------------------------------------------------------------------------------
 
 
-@kernel
+@inline
 def _box_excess_slope(c, u, s, half):
     """Half the derivative of the squared distance from ``c + s u`` to the box: ``(p - clamp(p)) · u``."""
     p = add_scaled(c, u, s)
@@ -527,7 +527,7 @@ def _box_excess_slope(c, u, s, half):
     )
 
 
-@kernel
+@inline
 def _segment_box_closest(c, u, half_length, half):
     """Parameter of the point of segment ``c + s u``, ``|s| <= half_length``, closest to the box (box frame).
 
@@ -554,7 +554,7 @@ def _segment_box_closest(c, u, half_length, half):
     return lo - g_lo * (hi - lo) / (g_hi - g_lo)
 
 
-@kernel
+@inline
 def _capsule_box_sat(c, u, half_length, half):
     """For a segment that cuts the box: the axis of least penetration among the 3 face normals and the 3
     segment × edge directions (faces preferred within the bias). Returns ``(m, centre, s)``: the unit axis from
@@ -586,7 +586,7 @@ def _capsule_box_sat(c, u, half_length, half):
     return m, _from_axes(face, 0.0, 0.0, side * half[face]), s
 
 
-@kernel
+@inline
 def _clip_to_feature(c, u, half_length, half, centre):
     """Clip the segment to the slabs of the axes along which the box feature at ``centre`` extends.
 
@@ -614,7 +614,7 @@ def _clip_to_feature(c, u, half_length, half, centre):
     return s0, a0, b0, s1, a1, b1
 
 
-@kernel
+@inline
 def _upright(u, m):
     """Whether the capsule axis ``u`` is along ``m``: its cross-section then has no lowest line, only the end
     ball's lowest point."""
@@ -622,7 +622,7 @@ def _upright(u, m):
     return math.sqrt(max(0.0, 1.0 - along * along)) <= _MIN_AXIS_LENGTH
 
 
-@kernel
+@inline
 def _capsule_reach(u, m, t, half_length):
     """Unit direction from the segment point at ``t`` to the capsule's surface point lowest along ``-m``.
 
@@ -638,7 +638,7 @@ def _capsule_reach(u, m, t, half_length):
     return scale(across, 1.0 / length) if length > _MIN_AXIS_LENGTH else m
 
 
-@kernel
+@inline
 def _over_feature(p, half, centre):
     """Whether ``p`` lies within the slabs of the axes along which the box feature at ``centre`` extends."""
     for j in range(3):
@@ -647,7 +647,7 @@ def _over_feature(p, half, centre):
     return True
 
 
-@kernel
+@inline
 def _emit_capsule_point(count, surface, m, support, margin, fid, pos_b, quat_b, point, separation, feature):
     """Write the point of the capsule surface point ``surface`` (box frame) against the box's support plane
     along ``m`` if it is within the margin; returns the new count."""
@@ -659,7 +659,7 @@ def _emit_capsule_point(count, surface, m, support, margin, fid, pos_b, quat_b, 
     return count + 1
 
 
-@kernel
+@inline
 def _capsule_box_points(c, u, half_length, radius, half, m, centre, s, margin, pos_b, quat_b, normal, point,
                         separation, feature):  # fmt: skip
     """Write the capsule–box points for the box feature at ``centre`` touched along ``m`` (box frame, box →
@@ -746,7 +746,7 @@ def collide_capsule_box(geom, shape_a, pos_a, quat_a, shape_b, pos_b, quat_b, ma
 # --- box-box -------------------------------------------------------------------------------------------------
 
 
-@kernel
+@inline
 def _box_sat(t, rel, half_a, half_b):
     """Separations of box b (centre ``t``, axes the columns of ``rel``, both in a's frame) from box a.
 
@@ -786,7 +786,7 @@ def _box_sat(t, rel, half_a, half_b):
     return sep_a, face_a, sep_b, face_b, sep_e, edge_a, edge_b, axis_e
 
 
-@kernel
+@inline
 def _incident_face(t, rel, inc_half, k, sigma):
     """The face of the incident box (centre ``t``, axes the columns of ``rel``, in the reference box's frame)
     most opposed to the reference normal ``sigma e_k``.
@@ -815,14 +815,14 @@ def _incident_face(t, rel, inc_half, k, sigma):
     return quad, vertex_codes, edge_codes, _box_code(_from_axes(j, 0.0, 0.0, s * h))
 
 
-@kernel
+@inline
 def _face_coords(t, rel, v, k, sigma):
     """Incident-box point ``v`` in reference-face coordinates (see :func:`_incident_face`)."""
     f = _to_axes(k, add(t, mat_vec(rel, v)))
     return (f[0], f[1], sigma * f[2])
 
 
-@kernel
+@inline
 def _side_distance(p, side, e1, e2):
     """How far ``p`` lies outside side ``side`` of the reference rectangle (0: x = e1, 1: x = -e1, 2: y = e2,
     3: y = -e2); negative inside."""
@@ -835,7 +835,7 @@ def _side_distance(p, side, e1, e2):
     return -p[1] - e2
 
 
-@kernel
+@inline
 def _clip_edge(p, q, e1, e2):
     """Liang–Barsky: the part ``[t0, t1]`` of edge ``p → q`` inside the rectangle ``|x| <= e1, |y| <= e2`` and the
     sides that cut it there (-1 where an end is the edge's own). Nothing left gives sides -1 and ``t0 > t1``."""
@@ -857,13 +857,13 @@ def _clip_edge(p, q, e1, e2):
     return t0, side0, t1, side1
 
 
-@kernel
+@inline
 def _ref_code(k, sigma, h, x, y):
     """Box code of the reference-box feature centred at face coordinates ``(x, y)`` on the reference face."""
     return _box_code(_from_axes(k, x, y, sigma * h))
 
 
-@kernel
+@inline
 def _edge_candidates(p, q, edge_code, e1, e2, k, sigma, h):
     """The points where the incident edge ``p → q`` enters and leaves the reference rectangle (empty slots at
     ``z = inf``): ``(x, y, z, reference code, incident code)``."""
@@ -881,7 +881,7 @@ def _edge_candidates(p, q, edge_code, e1, e2, k, sigma, h):
     return entry, leave
 
 
-@kernel
+@inline
 def _side_offset(side, e1, e2):
     """Face coordinates of the centre of side ``side`` of the reference rectangle."""
     if side == 0:
@@ -893,7 +893,7 @@ def _side_offset(side, e1, e2):
     return 0.0, -e2
 
 
-@kernel
+@inline
 def _corner_candidate(quad, x, y, corner_code, face_code):
     """The reference corner ``(x, y)`` lifted onto the incident face if it lies inside the face's outline
     (projected along the reference normal), else an empty slot."""
@@ -909,7 +909,7 @@ def _corner_candidate(quad, x, y, corner_code, face_code):
     return (x, y, z, corner_code, face_code)
 
 
-@kernel
+@inline
 def _vertex_candidate(p, vertex_code, e1, e2, face_code):
     # Within the preference of the rim counts as inside: equal boxes stacked with a slight twist keep their corners
     # (and ids), and faces that meet exactly along their rims keep their contact.
@@ -918,7 +918,7 @@ def _vertex_candidate(p, vertex_code, e1, e2, face_code):
     return (0.0, 0.0, math.inf, face_code, vertex_code)
 
 
-@kernel
+@inline
 def _face_candidates(quad, vertex_codes, edge_codes, inc_face_code, e1, e2, k, sigma, h):
     """The 16 slots of the contact polygon between the reference rectangle and the incident quad: incident
     vertices inside the rectangle (4), incident edges' entry and exit points (8), reference corners inside the
@@ -945,7 +945,7 @@ def _face_candidates(quad, vertex_codes, edge_codes, inc_face_code, e1, e2, k, s
     return vertices + edges + corners
 
 
-@kernel
+@inline
 def _box_face_contact(ref_pos, ref_quat, ref_half, k, inc_pos, inc_quat, inc_half, margin, ref_is_a, normal, point,
                       separation, feature):  # fmt: skip
     """Face contact: clip the incident face against reference face ``k`` (on the incident box's side), reduce to
@@ -969,7 +969,7 @@ def _box_face_contact(ref_pos, ref_quat, ref_half, k, inc_pos, inc_quat, inc_hal
     return count
 
 
-@kernel
+@inline
 def _box_edge_contact(pos_a, quat_a, half_a, t, rel, half_b, i, j, axis, margin, normal, point, separation,
                       feature):  # fmt: skip
     """Edge contact: one point between edge ``i`` of a and edge ``j`` of b, those farthest along ``axis`` (a's
@@ -1060,14 +1060,14 @@ def collide_capsule_plane(geom, shape_a, pos_a, quat_a, shape_b, pos_b, quat_b, 
     return count
 
 
-@kernel
+@inline
 def _plane_local(geom, shape_b, pos_b, quat_b, pos_a, quat_a):
     """World normal of plane b, and its normal and offset in shape a's frame."""
     n, offset = _plane_world(geom, shape_b, pos_b, quat_b)
     return n, quat_rotate_inv(quat_a, n), offset - dot(n, pos_a)
 
 
-@kernel
+@inline
 def _write_plane_points(points, n_world, n_local, offset_local, margin, pos_a, quat_a, normal, point, separation,
                         feature):  # fmt: skip
     """Reduce the candidate ``points`` (a's frame; a tuple of 3-tuples or an (n, 3) array) of a shape on a plane

@@ -166,7 +166,7 @@ def _vertex(geom, i):
     return (geom.vertex_local[i, 0], geom.vertex_local[i, 1], geom.vertex_local[i, 2])
 
 
-@kernel
+@inline
 def proxy_support(px, vertices, d):
     """A point of the core farthest along ``d`` (shape frame, need not be unit) [m], shape frame.
 
@@ -205,7 +205,7 @@ def proxy_support(px, vertices, d):
     return _vertex_row(vertices, best_i)
 
 
-@kernel
+@inline
 def proxy_support_world(px, vertices, pos, quat, d):
     """:func:`proxy_support` for a core placed at ``(pos, quat)``: world direction in, world point out."""
     return add(pos, quat_rotate(quat, proxy_support(px, vertices, quat_rotate_inv(quat, d))))
@@ -217,7 +217,7 @@ def core_radius(geom, shape, face):
     return core_proxy(geom, shape, face)[1]
 
 
-@kernel
+@inline
 def core_size(geom, shape, face):
     """A length for relative tolerances [m]: about the radius of a ball holding the shape (core and radius)."""
     return core_proxy(geom, shape, face)[2]
@@ -235,7 +235,7 @@ def support_world(geom, shape, face, pos, quat, d):
     return proxy_support_world(core_proxy(geom, shape, face), geom.vertex_local, pos, quat, d)
 
 
-@kernel
+@inline
 def _support_pair(xa, pa, qa, xb, pb, qb, vertices, d):
     """The support points ``s_A(d)`` and ``s_B(-d)``, whose difference is the support of ``A - B`` along ``d``."""
     a = proxy_support_world(xa, vertices, pa, qa, d)
@@ -243,7 +243,7 @@ def _support_pair(xa, pa, qa, xb, pb, qb, vertices, d):
     return a, b
 
 
-@kernel
+@inline
 def _centre(px, pos, quat):
     """The proxy's inside point, world frame."""
     return add(pos, quat_rotate(quat, px[11]))
@@ -252,7 +252,7 @@ def _centre(px, pos, quat):
 # --- Johnson's sub-algorithm: the point of a simplex nearest the origin ----------------------------------
 
 
-@kernel
+@inline
 def _closest_on_segment(w0, w1):
     """Nearest point to the origin on the segment, with its barycentric weights ``(l0, l1)``."""
     e = sub(w1, w0)
@@ -265,7 +265,7 @@ def _closest_on_segment(w0, w1):
     return add_scaled(w0, e, t), 1.0 - t, t
 
 
-@kernel
+@inline
 def _closest_on_triangle(w0, w1, w2):
     """Nearest point to the origin on the triangle and its weights, by Voronoi regions (Ericson 2005, §5.1.5).
 
@@ -315,7 +315,7 @@ def _closest_on_triangle(w0, w1, w2):
     return p12, 0.0, c1, c2
 
 
-@kernel
+@inline
 def _closest_on_simplex(sim_a, sim_b, count):
     """Replace the simplex (rows ``[:count]`` of the support points of A and B) by its sub-simplex nearest the origin.
 
@@ -394,7 +394,7 @@ def _row(array, i):
     return (array[i, 0], array[i, 1], array[i, 2])
 
 
-@kernel
+@inline
 def proxy_gjk(xa, pa, qa, xb, pb, qb, vertices, max_distance, sim_a, sim_b):
     """Distance between the cores of two convex shapes (radii not included).
 
@@ -494,7 +494,7 @@ def proxy_gjk(xa, pa, qa, xb, pb, qb, vertices, max_distance, sim_a, sim_b):
 # walk's stack, the horizon and the fan are read only below their fill level.
 
 
-@kernel
+@inline
 def _epa_push(xa, pa, qa, xb, pb, qb, vertices, d, va, vb, n):
     """Append the support pair along ``d`` as vertex ``n``; return its point of ``A - B``."""
     a, b = _support_pair(xa, pa, qa, xb, pb, qb, vertices, d)
@@ -514,7 +514,7 @@ def _copy_vertex(va, vb, to, source):
         va[to, c], vb[to, c] = va[source, c], vb[source, c]
 
 
-@kernel
+@inline
 def _epa_seed(xa, pa, qa, xb, pb, qb, vertices, va, vb, count, tol):
     """Grow GJK's simplex (1 to 4 points, the origin on or in it) into a tetrahedron: any point away from a single
     point, the point farthest from a segment's line, the higher apex over a triangle. The origin is then inside or on
@@ -629,7 +629,7 @@ def _perpendicular(u):
     return scale(p, 1.0 / math.sqrt(dot(p, p)))
 
 
-@kernel
+@inline
 def _epa_flat_answer(xa, pa, qa, xb, pb, qb, vertices, va, vb, count, hint):
     """Exit 1 (and 4): ``A - B`` has no volume round the origin. Depth 0, the normal of the flat set (see
     :func:`_flat_normal`), and the mean of the ``count`` support pairs as the points."""
@@ -657,7 +657,7 @@ def _epa_polytope():
             np.empty(walk, np.int64))  # fmt: skip
 
 
-@kernel
+@inline
 def _epa_update_face(va, vb, faces, normal, dist, f):
     """Unit normal and origin distance of face ``f`` as wound (a face with no area: zero normal, infinite distance,
     so it is never the nearest)."""
@@ -672,7 +672,7 @@ def _epa_update_face(va, vb, faces, normal, dist, f):
     normal[f, 0], normal[f, 1], normal[f, 2] = n[0], n[1], n[2]
 
 
-@kernel
+@inline
 def _epa_link(faces, adj, adj_edge, f, g):
     """Link ``f`` and ``g`` as neighbours across the edge they share (walked in opposite directions); False if none."""
     for e in range(3):
@@ -786,7 +786,7 @@ def _epa_grow(va, vb, poly, best, count, face_count, depth, tol, flat):
     return face_count
 
 
-@kernel
+@inline
 def _epa_expand(xa, pa, qa, xb, pb, qb, vertices, va, vb, poly, tol, flat):
     """Push out the nearest face until it lies on the boundary of ``A - B`` (exit 2) or no sound step is left
     (exit 3). Returns ``(status, depth, face, normal)``: the nearest face's distance, vertex rows and unit normal;
@@ -812,7 +812,7 @@ def _epa_expand(xa, pa, qa, xb, pb, qb, vertices, va, vb, poly, tol, flat):
     return EPA_STOPPED, dist[best], (faces[best, 0], faces[best, 1], faces[best, 2]), _row(normal, best)
 
 
-@kernel
+@inline
 def _epa_witnesses(va, vb, depth, face, n):
     """The origin's projection on the answer's face, ``depth · n``, in barycentric weights of the face's support
     pairs: the deepest points of A and B."""
@@ -871,14 +871,14 @@ def proxy_epa(xa, pa, qa, xb, pb, qb, vertices, sim_a, sim_b, count):
 # --- the whole query ---------------------------------------------------------------------------------------------
 
 
-@kernel
+@inline
 def _core_overlap(xa, pa, qa, xb, pb, qb, vertices, u):
     """How far core B must move along the unit ``u`` to clear core A: ``h_A(u) + h_B(-u)``, and the two supports."""
     a, b = _support_pair(xa, pa, qa, xb, pb, qb, vertices, u)
     return dot(u, sub(a, b)), a, b
 
 
-@kernel
+@inline
 def _polish_depth(xa, pa, qa, xb, pb, qb, vertices, n, ca, cb):
     """EPA's answer measured again along its normal, and the axes of round cores tried as well.
 
@@ -930,7 +930,7 @@ def _polish_depth(xa, pa, qa, xb, pb, qb, vertices, n, ca, cb):
     return depth, best, ca, cb
 
 
-@kernel
+@inline
 def _flat_depth(xa, pa, qa, xb, pb, qb, vertices, n, ca, cb):
     """Depth and normal when ``A - B`` has no volume near the origin (points, segments, a point in a triangle's
     plane): the least core overlap over the flat set's normal ``n`` (either way) and the direction of GJK's last
@@ -954,7 +954,7 @@ def _flat_depth(xa, pa, qa, xb, pb, qb, vertices, n, ca, cb):
     return depth, best
 
 
-@kernel
+@inline
 def proxy_contact(xa, pa, qa, xb, pb, qb, vertices, max_separation):
     """Signed separation of two convex cores (:func:`core_proxy`) with their radii: GJK, then EPA on overlap.
 
@@ -990,7 +990,7 @@ def proxy_contact(xa, pa, qa, xb, pb, qb, vertices, max_separation):
     return True, separation, n, add_scaled(ca, n, ra), add_scaled(cb, n, -rb)
 
 
-@kernel
+@inline
 def _flat_normal(xa, pa, qa, xb, pb, qb, vertices, va, vb, count, hint):
     """A unit normal from A to B when ``A - B`` has no volume round the origin (two points, a point on a segment, a
     sphere's centre in a triangle's plane...). The cores are then tangent along the flat set's normal, or along any

@@ -12,7 +12,7 @@ import math
 
 import numpy as np
 
-from .._jit import kernel, kernel_for
+from .._jit import inline, kernel, kernel_for
 from ..math3d import add, load3, load4, quat_mul, quat_rotate
 from .collide_convex import collide_convex_convex, collide_convex_trimesh
 from .collide_primitives import (
@@ -35,7 +35,7 @@ __all__ = ["collide_pairs", "match_warm_start", "shape_world_pose"]
 SPHERE, CAPSULE, BOX, CYLINDER, HULL, PLANE, TRIMESH = 0, 1, 2, 3, 4, 5, 6
 
 
-@kernel
+@inline
 def shape_world_pose(geom, s, body_pos, body_quat):
     """World pose of shape ``s``: its body's COM frame composed with the shape's local pose."""
     b = geom.shape_body[s]
@@ -44,7 +44,7 @@ def shape_world_pose(geom, s, body_pos, body_quat):
     return pos, quat_mul(qb, load4(geom.shape_quat_local, s))
 
 
-@kernel
+@inline
 def _reach(geom, s, body_linvel, body_angvel):
     """How far any point of shape ``s`` can move per second: ``|v| + |ω| r`` with ``r`` its bounding radius."""
     b = geom.shape_body[s]

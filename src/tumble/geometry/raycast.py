@@ -68,7 +68,7 @@ class RayHit(NamedTuple):
 # takes 3.5 s instead of 6.3 s (measured), for a call per shape that a ray query does not notice.
 
 
-@kernel
+@inline
 def _ray_sphere(r, o, d, t_max):
     """Ray ``o + t d`` (unit ``d``) against the ball ``|x| <= r`` (Ericson 2005, §5.3.2).
 
@@ -103,7 +103,7 @@ def _ray_infinite_cylinder(r, o, d):
     return a, b, a * (r * r - fx * fx - fy * fy)
 
 
-@kernel
+@inline
 def _ray_box(half, o, d, t_max):
     """Ray against the box ``|x_k| <= half_k``: the intersection of three slabs (Ericson 2005, §5.3.3)."""
     t_in, t_out, axis_in = -math.inf, math.inf, -1
@@ -129,7 +129,7 @@ def _ray_box(half, o, d, t_max):
     return t_in, (s if axis_in == 0 else 0.0, s if axis_in == 1 else 0.0, s if axis_in == 2 else 0.0)
 
 
-@kernel
+@inline
 def _ray_cylinder(r, half_h, o, d, t_max):
     """Ray against the solid cylinder ``x² + y² <= r², |z| <= half_h``: the z slab's interval intersected with
     the infinite cylinder's (Ericson 2005, §5.3.7)."""
@@ -164,7 +164,7 @@ def _ray_cylinder(r, half_h, o, d, t_max):
     return t_in, (p[0] / radial, p[1] / radial, 0.0)
 
 
-@kernel
+@inline
 def _ray_capsule(r, half_len, o, d, t_max):
     """Ray against the capsule: the segment ``z ∈ [-half_len, half_len]`` swept by ``r``.
 
@@ -189,7 +189,7 @@ def _ray_capsule(r, half_len, o, d, t_max):
     return best_t, best_n
 
 
-@kernel
+@inline
 def _ray_plane(normal, offset, o, d, t_max):
     """Ray against the half-space ``n · x <= offset``."""
     distance = math3d.dot(normal, o) - offset
@@ -201,7 +201,7 @@ def _ray_plane(normal, offset, o, d, t_max):
     return -distance / rate, normal
 
 
-@kernel
+@inline
 def _ray_hull(geom, s, o, d, t_max):
     """Ray against a convex hull: clipped by the half-space ``n_f · x <= offset_f`` of each face
     (Ericson 2005, §5.3.8); the hit is on the face that clips the ray's start last."""
@@ -250,7 +250,7 @@ def _ray_triangle(p0, p1, p2, o, d):
     return math3d.dot(e2, qvec) * inv_det
 
 
-@kernel
+@inline
 def _ray_trimesh(geom, s, o, d, t_max):
     """Ray against every triangle of a mesh; the first crossing, normal turned towards the ray."""
     best_t, best_face = _MISS, -1
@@ -270,7 +270,7 @@ def _ray_trimesh(geom, s, o, d, t_max):
     return best_t, normal
 
 
-@kernel
+@inline
 def _ray_shape(geom, s, o, d, t_max):
     """Dispatch on the shape type; ``o``, ``d`` in the shape frame."""
     kind = geom.shape_type[s]

@@ -25,7 +25,7 @@ import math
 
 import numpy as np
 
-from .._jit import kernel
+from .._jit import inline, kernel
 from ..math3d import add, dot, load3, load4, quat_conj, quat_mul, quat_rotate, quat_rotate_inv, scale, sub
 from ..shapes import ShapeType
 from .gjk import POINT, core_proxy, proxy_contact
@@ -85,7 +85,7 @@ def _fast_bodies(geom, pos0, quat0, pos, quat) -> np.ndarray:
     return motion > 0.5 * smallest
 
 
-@kernel
+@inline
 def _pose_at(x0, q0, x1, q1, t):
     """The body pose a fraction ``t`` of the way from ``(x0, q0)`` to ``(x1, q1)`` (shortest rotation)."""
     dq = quat_mul(q1, quat_conj(q0))
@@ -101,7 +101,7 @@ def _pose_at(x0, q0, x1, q1, t):
     return add(x0, scale(sub(x1, x0), t)), quat_mul(turn, q0)
 
 
-@kernel
+@inline
 def _distance_to_static(geom, proxy, pp, qp, k, pk, qk, radius):
     """Distance from a convex proxy placed at ``(pp, qp)`` to static shape ``k``; for a mesh, to its nearest triangle
     among those that meet the ball of ``radius`` round ``pp``."""
