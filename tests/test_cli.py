@@ -405,16 +405,19 @@ def test_the_bar_says_that_kernels_compile_until_the_first_chunk():
     assert progress.compiled == 3  # the listener went with the bar
 
 
-def test_warmup_steps_each_scene_in_its_own_process_and_reports_failures(tmp_path, monkeypatch, capsys):
+def test_warmup_steps_every_scene_and_reports_failures(tmp_path, monkeypatch, capsys):
     from tumble import cli, scene_file, warmup
 
     shipped = {p.stem: p for p in scene_file.shipped()}
     broken = tmp_path / "broken.toml"
     broken.write_text("[world]\ngravity = [0, 0]\n")
     results = warmup.warmup(2, scenes=[shipped["pendulum"], broken, shipped["flagship"]])
-    assert [r.name for r in results if r.error is None] in (["pendulum", "flagship"], ["flagship", "pendulum"])
+    assert sorted(r.name for r in results if r.error is None) == ["flagship", "pendulum"]
     (failed,) = [r for r in results if r.error is not None]
     assert failed.name == "broken" and "gravity" in failed.error
+    # One process steps the broken scene and then the pendulum: a scene's failure does not stop the next.
+    results = warmup.warmup(1, scenes=[shipped["pendulum"], broken, shipped["dzhanibekov"]])
+    assert [(r.name, r.error is None) for r in results] == [("dzhanibekov", 1), ("broken", 0), ("pendulum", 1)]
     monkeypatch.setattr(scene_file, "shipped", lambda: [shipped["pendulum"], shipped["dzhanibekov"]])
     assert cli.main(["warmup", "--jobs", "1"]) == cli.EXIT_OK
     err = capsys.readouterr().err
@@ -424,3 +427,16 @@ def test_warmup_steps_each_scene_in_its_own_process_and_reports_failures(tmp_pat
     with pytest.raises(SystemExit) as exit_info:  # argparse refuses it, with the status of bad input
         cli.main(["warmup", "--jobs", "0"])
     assert exit_info.value.code == cli.EXIT_BAD_INPUT
+
+
+def test_warmup_runs_the_scenes_with_kernels_of_their_own_alone_first_and_deals_out_the_rest():
+    from tumble import scene_file, warmup
+
+    scenes = list(scene_file.shipped())
+    batches = warmup._batches(scenes, 2)
+    assert [b[0].stem for b in batches[: len(warmup.FIRST)]] == list(warmup.FIRST)
+    assert all(len(b) == 1 for b in batches[: len(warmup.FIRST)])
+    rest = batches[len(warmup.FIRST) :]
+    assert len(rest) == 2 and abs(len(rest[0]) - len(rest[1])) <= 1
+    assert sorted(p for b in batches for p in b) == sorted(scenes)
+    assert warmup._batches(scenes[:1], 4) == [scenes[:1]]

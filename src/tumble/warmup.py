@@ -2,30 +2,33 @@
 
 Numba compiles a kernel on its first call and keeps it in its on-disk cache (``cache=True``), so the first run on a
 fresh machine waits for the compiler: about 100 s of CPU for the flagship scene. Warming up steps each shipped scene
-a few times, every scene in a process of its own, ``jobs`` processes at a time; they share the cache, so what one
-has compiled the next loads (0.1 s for ten kernels) instead of compiling it again. The largest scenes go first, one
-per process, so that two cores compile two different sets of kernels at once.
+a few times, ``jobs`` processes at a time; they share the cache, so what one has compiled the next loads (0.1 s for
+ten kernels) instead of compiling it again. The scenes that need kernels no other scene does go first, one per
+process, so that two cores compile two different sets of kernels at once; the rest, which mostly load what those
+compiled, follow in ``jobs`` processes that each step several scenes (a process of its own cost each about 1 s of
+start-up and loading).
 
 ``make install`` runs it once; after that, ``tumble run`` of any scene starts at once.
 """
 
 from __future__ import annotations
 
+import json
 import os
 import subprocess
 import sys
 import tempfile
 import time
-import typing
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
 __all__ = ["WarmedScene", "warm_scene", "warmup", "default_jobs"]
 
-# Scenes that need the most kernels, first: the flagship (contacts of every primitive pair, meshes, hulls, joints)
-# and the quadrotor (rotors, flights, wind); the rest follow in name order and mostly load what these compiled.
-FIRST = ("flagship", "quadrotor_figure_eight_wind", "robot_arm", "ragdoll_stairs")
+# Scenes that need kernels of their own, first, each in its own process: the flagship (contacts of every primitive
+# pair, meshes, hulls, joints), the quadrotor (rotors, flights, wind), the arm (articulation), the free-body
+# integrators; the rest follow in name order and mostly load what these compiled.
+FIRST = ("flagship", "quadrotor_figure_eight_wind", "robot_arm", "dzhanibekov", "ragdoll_stairs")
 # [s] of each scene's simulated time: kernels are compiled as stages are first reached (the flagship's bodies reach
 # the bowl after about 0.3 s: 3 steps compiled 311 functions, 1 s 349, the whole 8 s 351).
 WARM_SECONDS = 1.0
@@ -56,46 +59,78 @@ def warm_scene(path: str | os.PathLike) -> None:
     world.step(dt)
 
 
-def _ordered(scenes: list[Path]) -> list[Path]:
+def _batches(scenes: list[Path], jobs: int) -> list[list[Path]]:
+    """The processes to run, in order: each of :data:`FIRST` alone (in that order), then the other scenes in name
+    order, dealt out to ``jobs`` processes."""
     rank = {name: k for k, name in enumerate(FIRST)}
-    return sorted(scenes, key=lambda p: (rank.get(p.stem, len(FIRST)), p.stem))
+    first = sorted((p for p in scenes if p.stem in rank), key=lambda p: rank[p.stem])
+    rest = sorted((p for p in scenes if p.stem not in rank), key=lambda p: p.stem)
+    return [[p] for p in first] + [batch for batch in (rest[k::jobs] for k in range(jobs)) if batch]
 
 
 def warmup(jobs: int | None = None, *, scenes: list[Path] | None = None,
            on_done: Callable[[WarmedScene, int, int], None] | None = None) -> list[WarmedScene]:  # fmt: skip
     """Warm the kernels of ``scenes`` (default: every shipped scene) in ``jobs`` processes at a time (default: one
-    per core); ``on_done(result, done, total)`` is called as each process ends. Returns one result per scene."""
+    per core); ``on_done(result, done, total)`` is called for each scene as its process ends. Returns one result
+    per scene."""
     from . import scene_file
 
     jobs = default_jobs() if jobs is None else jobs
     if isinstance(jobs, bool) or not isinstance(jobs, int) or jobs < 1:
         raise ValueError(f"jobs must be an integer >= 1, got {jobs!r}")
-    queue = _ordered(list(scene_file.shipped()) if scenes is None else [Path(p) for p in scenes])
-    running: list[tuple[Path, subprocess.Popen, float, typing.IO]] = []
+    queue = _batches(list(scene_file.shipped()) if scenes is None else [Path(p) for p in scenes], jobs)
+    total = sum(len(batch) for batch in queue)
+    running: list[_Process] = []
     results: list[WarmedScene] = []
-    total = len(queue)
     while queue or running:
         while queue and len(running) < jobs:
-            path = queue.pop(0)
-            command = [sys.executable, "-m", "tumble.warmup", str(path)]
-            errors = tempfile.TemporaryFile("w+")  # a file, not a pipe: a child with much to say never blocks
-            process = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=errors, text=True)
-            running.append((path, process, time.perf_counter(), errors))
+            running.append(_Process(queue.pop(0)))
         time.sleep(0.05)
-        for entry in list(running):
-            path, process, started, errors = entry
-            if process.poll() is None:
-                continue
-            running.remove(entry)
-            errors.seek(0)
-            stderr = errors.read()
-            errors.close()
-            error = None if process.returncode == 0 else (stderr.strip().splitlines() or ["failed"])[-1]
-            results.append(WarmedScene(path.stem, time.perf_counter() - started, error))
-            if on_done is not None:
-                on_done(results[-1], len(results), total)
+        for process in [p for p in running if p.done()]:
+            running.remove(process)
+            for result in process.results():
+                results.append(result)
+                if on_done is not None:
+                    on_done(result, len(results), total)
     return results
 
 
-if __name__ == "__main__":  # one scene, in a process of its own (see warmup)
-    warm_scene(sys.argv[1])
+class _Process:
+    """A child warming ``paths`` one after the other; it writes one JSON line per scene to stdout. Both streams go
+    to files, not pipes: a child with much to say never blocks."""
+
+    def __init__(self, paths: list[Path]) -> None:
+        self.paths = paths
+        self._out, self._err = tempfile.TemporaryFile("w+"), tempfile.TemporaryFile("w+")
+        command = [sys.executable, "-m", "tumble.warmup", *(str(p) for p in paths)]
+        self._child = subprocess.Popen(command, stdout=self._out, stderr=self._err, text=True)
+
+    def done(self) -> bool:
+        return self._child.poll() is not None
+
+    def results(self) -> list[WarmedScene]:
+        """One result per path: the child's report, or for a scene it did not report (it crashed) its exit."""
+        self._out.seek(0)
+        self._err.seek(0)
+        reported = [WarmedScene(**json.loads(line)) for line in self._out.read().splitlines() if line.startswith("{")]
+        stderr = self._err.read().strip().splitlines()
+        self._out.close()
+        self._err.close()
+        crash = stderr[-1] if stderr else f"exit status {self._child.returncode}"
+        return reported + [WarmedScene(p.stem, 0.0, crash) for p in self.paths[len(reported) :]]
+
+
+def _warm_each(paths: list[str]) -> None:
+    """Warm each scene in turn, reporting each (and the error it ended with) on a line of stdout."""
+    for path in paths:
+        began, error = time.perf_counter(), None
+        try:
+            warm_scene(path)
+        except Exception as exc:  # reported to the parent, which names the scene
+            error = f"{type(exc).__name__}: {exc}"
+        seconds = time.perf_counter() - began
+        print(json.dumps({"name": Path(path).stem, "seconds": seconds, "error": error}), flush=True)
+
+
+if __name__ == "__main__":  # scenes in a process of their own (see warmup)
+    _warm_each(sys.argv[1:])
