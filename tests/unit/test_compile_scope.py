@@ -107,3 +107,31 @@ def test_every_type_pair_goes_to_its_collision_function():
     }  # fmt: skip
     for (ta, tb), name in expected.items():
         assert narrow_phase._PAIR_KERNELS[narrow_phase._COLLIDER_OF[ta, tb]].__name__ == f"pairs_{name}"
+
+
+def test_pairs_are_grouped_by_collision_function_in_pair_order():
+    rng = np.random.default_rng(7)
+    shape_type = rng.integers(0, 7, size=40)
+    pairs_a, pairs_b = rng.integers(0, 40, size=300), rng.integers(0, 40, size=300)
+    low = np.minimum(shape_type[pairs_a], shape_type[pairs_b]) == shape_type[pairs_a]
+    pairs_a, pairs_b = np.where(low, pairs_a, pairs_b), np.where(low, pairs_b, pairs_a)  # lower shape type first
+    order, starts = np.empty(300, np.int64), np.zeros(len(narrow_phase._COLLIDERS) + 1, np.int64)
+    narrow_phase._group_by_collider(shape_type, pairs_a, pairs_b, narrow_phase._COLLIDER_OF, order, starts)
+    which = narrow_phase._COLLIDER_OF[shape_type[pairs_a], shape_type[pairs_b]]
+    assert np.array_equal(order, np.argsort(which, kind="stable"))
+    assert np.array_equal(np.diff(starts), np.bincount(which, minlength=len(narrow_phase._COLLIDERS)))
+
+
+def test_touching_manifolds_move_to_the_front_in_pair_order():
+    rng = np.random.default_rng(8)
+    manifolds = narrow_phase.allocate_manifolds(50)
+    for field in manifolds:
+        field[...] = rng.integers(1, 1000, size=field.shape)
+    manifolds.point_count[:] = rng.integers(0, 3, size=50)
+    manifolds.point_count[40:] = 1  # beyond n: not counted, not moved
+    before = [field.copy() for field in manifolds]
+    touching = np.flatnonzero(before[3][:40] > 0)
+    count = narrow_phase._keep_touching(manifolds, 40)
+    assert count == touching.size
+    for field, old in zip(manifolds, before, strict=True):
+        assert np.array_equal(field[:count], old[touching])

@@ -109,6 +109,42 @@ def _collider_table() -> np.ndarray:
 _COLLIDER_OF = _collider_table()
 
 
+@kernel
+def _group_by_collider(shape_type, pairs_a, pairs_b, table, order, starts):
+    """A counting sort of the pairs by collision function: the pairs of function ``i`` are
+    ``order[starts[i]:starts[i + 1]]``, in pair order. One compiled call instead of a dozen NumPy ones per step.
+    Writes: order (n,), starts (functions + 1,) (zeros on entry)."""
+    n = pairs_a.shape[0]
+    which = np.empty(n, dtype=np.int64)
+    for k in range(n):
+        which[k] = table[shape_type[pairs_a[k]], shape_type[pairs_b[k]]]
+        starts[which[k] + 1] += 1
+    for i in range(1, starts.shape[0]):
+        starts[i] += starts[i - 1]
+    filled = starts[:-1].copy()
+    for k in range(n):
+        order[filled[which[k]]] = k
+        filled[which[k]] += 1
+
+
+@kernel
+def _keep_touching(manifolds, n):
+    """Move the manifolds of the first ``n`` pairs that have points to the front, in order; returns how many."""
+    count = 0
+    for k in range(n):
+        if manifolds.point_count[k] == 0:
+            continue
+        if count < k:
+            manifolds.shape_a[count], manifolds.shape_b[count] = manifolds.shape_a[k], manifolds.shape_b[k]
+            manifolds.normal[count] = manifolds.normal[k]
+            manifolds.point_count[count] = manifolds.point_count[k]
+            manifolds.point[count] = manifolds.point[k]
+            manifolds.separation[count] = manifolds.separation[k]
+            manifolds.feature[count] = manifolds.feature[k]
+        count += 1
+    return count
+
+
 def collide_pairs(geom, body_pos, body_quat, body_linvel, body_angvel, pairs_a, pairs_b, margin, dt, manifolds):
     """Manifolds of the candidate pairs that touch or are within their margin, in pair order; returns how many.
 
@@ -118,17 +154,14 @@ def collide_pairs(geom, body_pos, body_quat, body_linvel, body_angvel, pairs_a, 
     n = pairs_a.shape[0]
     if n == 0:
         return 0
-    which = _COLLIDER_OF[geom.shape_type[pairs_a], geom.shape_type[pairs_b]]
+    order, starts = np.empty(n, dtype=np.int64), np.zeros(len(_COLLIDERS) + 1, dtype=np.int64)
+    _group_by_collider(geom.shape_type, pairs_a, pairs_b, _COLLIDER_OF, order, starts)
     args = (geom, body_pos, body_quat, body_linvel, body_angvel, pairs_a, pairs_b)
-    for i in np.flatnonzero(np.bincount(which, minlength=len(_COLLIDERS))):
-        _PAIR_KERNELS[i](*args, np.flatnonzero(which == i), margin, dt, manifolds)
-    # Keep the pairs that made contact, in order, at the front.
-    touching = np.flatnonzero(manifolds.point_count[:n] > 0)
-    count = touching.size
-    if count < n:
-        for field in manifolds:
-            field[:count] = field[touching]
-    return count
+    bounds = starts.tolist()
+    for i, run in enumerate(_PAIR_KERNELS):
+        if bounds[i + 1] > bounds[i]:
+            run(*args, order[bounds[i] : bounds[i + 1]], margin, dt, manifolds)
+    return _keep_touching(manifolds, n)
 
 
 @kernel
