@@ -53,6 +53,7 @@ import numba
 import numpy as np
 
 import tumble
+from tumble.dynamics import integrate
 
 from . import articulation, broad_phase, build, contact, first_run, joints, peers, quadrotor
 
@@ -171,6 +172,7 @@ def machine_info() -> dict[str, object]:
         "cpu": _cpu_model(),
         "cores": usable,
         "numba_threads": numba.get_num_threads(),
+        "tumble_threads": integrate.threads(),
         "python": platform.python_version(),
         "numpy": np.__version__,
         "numba": numba.__version__,
@@ -362,13 +364,9 @@ class _Contender:
 
 def _tumble_contender(world: tumble.World, integrator: str, threads: int, steps: int, build_s: float) -> _Contender:
     def run() -> float:
-        default_threads = numba.get_num_threads()
         world.integrator = integrator
-        numba.set_num_threads(threads)
-        try:
+        with integrate.using_threads(threads):
             elapsed, _ = _timed(world.simulate, steps * DT, DT, record_every=steps)
-        finally:
-            numba.set_num_threads(default_threads)
         if not np.all(np.isfinite(world.state.body_pos)):
             raise RuntimeError(f"tumble {integrator}: non-finite positions in the many-bodies run")
         return elapsed
@@ -424,7 +422,7 @@ def bench_many_bodies(sizes: Sizes = FULL) -> list[dict]:
     steps on one thread). The tumble world keeps falling from one call to the next.
     """
     build_s, world = _timed(_many_bodies_world, sizes.bodies)
-    threads = numba.get_num_threads()
+    threads = integrate.threads()
     contenders = [
         _tumble_contender(world, integrator, count, sizes.body_steps, build_s)
         for integrator in ("auto", "symplectic")
@@ -575,6 +573,10 @@ def check_targets(results: dict[str, list[dict]]) -> list[dict]:
         if row is not None and "x_mujoco" in row:
             label = f"{row['bodies']} bodies, {integrator}, {threads} threads vs MuJoCo Euler (x)"
             add(label, row["x_mujoco"], ">= 10", row["x_mujoco"] >= 10)
+        one = _find(many, engine="tumble", integrator=integrator, threads=1)
+        if row is not None and one is not None and threads > 1:
+            gain = row["body_steps_per_s"] / one["body_steps_per_s"]
+            add(f"{row['bodies']} bodies, {integrator}: {threads} threads over 1 (x)", gain, ">= 1.7", gain >= 1.7)
     targets += _contact_targets(results)
     for row in results.get("cold_start", []):
         if row["order"] != "step first":

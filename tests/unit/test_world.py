@@ -2,11 +2,16 @@
 
 from __future__ import annotations
 
+import os
+import re
+
 import numpy as np
 import pytest
 
 import tumble
 from tumble import mass as tm
+from tumble import scenes
+from tumble.dynamics import integrate
 from tumble.rotation import quat_from_axis_angle, quat_to_matrix
 
 
@@ -154,19 +159,59 @@ def test_runs_are_bit_identical_and_simulate_equals_repeated_steps(integrator):
     assert a.state.digest() == b.state.digest() == c.state.digest()
 
 
-def test_threaded_and_single_threaded_runs_agree_bit_for_bit(monkeypatch):
-    from tumble.dynamics import integrate
+two_cores = pytest.mark.skipif((os.cpu_count() or 1) < 2, reason="needs two cores")
 
+
+@two_cores
+def test_threaded_and_single_threaded_runs_agree_bit_for_bit(monkeypatch):
     threaded, single = _scene(), _scene()
     monkeypatch.setattr(integrate, "PARALLEL_MIN_WORK", 1)
-    monkeypatch.setattr(integrate, "_THREADS", 2)
-    threaded.simulate(0.5, 1e-3)  # split into two blocks of rows, one per thread
-    for _ in range(500):
-        single.step(1e-3)  # threaded too, one step at a time
-    monkeypatch.setattr(integrate, "_THREADS", 1)
-    again = _scene()
-    again.simulate(0.5, 1e-3)
+    with integrate.using_threads(2):
+        threaded.simulate(0.5, 1e-3)  # split into two blocks of rows, one per thread
+        for _ in range(500):
+            single.step(1e-3)  # threaded too, one step at a time
+    with integrate.using_threads(1):
+        again = _scene()
+        again.simulate(0.5, 1e-3)
     assert threaded.state.digest() == single.state.digest() == again.state.digest()
+
+
+def _free_spheres(n):
+    world = tumble.World()
+    spins = np.random.default_rng(0).normal(0.0, 5.0, (n, 3))
+    for k in range(n):
+        position = (0.2 * (k % 64), 0.2 * (k // 64), 1.0)
+        world.add_body(tumble.Sphere(0.05), mass=1.0, position=position, angular_velocity=spins[k], collision_mask=0)
+    return world
+
+
+@two_cores
+@pytest.mark.skipif(os.environ.get("NUMBA_DISABLE_JIT") == "1", reason="minutes as plain Python")
+@pytest.mark.parametrize("integrator", ["auto", "symplectic"])
+def test_4096_free_bodies_and_a_pile_give_the_same_bits_on_one_thread_and_two(integrator):
+    """4096 bodies for 60 steps is above the size at which the free bodies split across threads; the pile (contacts)
+    runs its one thread either way."""
+    digests = {}
+    for count in (1, 2):
+        with integrate.using_threads(count):
+            bodies = _free_spheres(4096)
+            bodies.integrator = integrator
+            assert 4096 * 60 >= integrate.PARALLEL_MIN_WORK
+            bodies.simulate(0.06, 1e-3)
+            pile = scenes.box_pile(27)
+            pile.simulate(0.25, 1 / 240)
+        digests[count] = (bodies.state.digest(), pile.state.digest())
+    assert digests[1] == digests[2]
+
+
+@pytest.mark.parametrize("count", [0, -1, 1.5, True, "2", 10**6])
+def test_using_threads_refuses_what_is_not_a_thread_count(count):
+    before = integrate.threads()
+    message = rf"count must be a number of threads from 1 to \d+ \(one per core\), got {re.escape(repr(count))}"
+    with pytest.raises(ValueError, match=message):
+        with integrate.using_threads(count):
+            pass
+    assert integrate.threads() == before
 
 
 def test_non_finite_step_raises_and_keeps_the_last_good_state():

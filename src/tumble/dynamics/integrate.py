@@ -15,6 +15,7 @@ replays exactly the steps that all bodies completed, so the world stops at its l
 
 from __future__ import annotations
 
+import contextlib
 import os
 import warnings
 from concurrent.futures import ThreadPoolExecutor
@@ -29,7 +30,7 @@ from ..params import Integrator
 from ..state import State
 from .free_motion import euler_step, midpoint_step, rk4_step, symplectic_step
 
-__all__ = ["Recording", "advance_free_bodies", "PARALLEL_MIN_WORK", "thread_count"]
+__all__ = ["Recording", "advance_free_bodies", "PARALLEL_MIN_WORK", "thread_count", "threads", "using_threads"]
 
 # Below this many body-steps per call the threads cost more than they save (measured: one body for 20 000
 # steps ran 5 % slower split across threads).
@@ -59,6 +60,7 @@ def thread_count(setting: str | None, cores: int | None) -> int:
 
 _THREADS = thread_count(os.environ.get("TUMBLE_THREADS"), os.cpu_count())
 _POOL: ThreadPoolExecutor | None = None
+_POOL_SIZE = 0
 
 
 class Recording(NamedTuple):
@@ -177,10 +179,33 @@ def _advance_rows_kernel(bodies, gravity, force, torque, acts, pos, quat, linvel
     return first_failure
 
 
+def threads() -> int:
+    """The threads free bodies run on (``TUMBLE_THREADS``, or :func:`using_threads` inside its block)."""
+    return _THREADS
+
+
+@contextlib.contextmanager
+def using_threads(count: int):
+    """Run free bodies on ``count`` threads (1 to one per core) inside the block, then as before: the benchmarks
+    time one and two threads in one process (``numba.set_num_threads`` does not reach these threads)."""
+    global _THREADS
+    cores = max(1, os.cpu_count() or 1)
+    if isinstance(count, bool) or not isinstance(count, int) or not 1 <= count <= cores:
+        raise ValueError(f"count must be a number of threads from 1 to {cores} (one per core), got {count!r}")
+    before, _THREADS = _THREADS, count
+    try:
+        yield
+    finally:
+        _THREADS = before
+
+
 def _thread_pool() -> ThreadPoolExecutor:
-    global _POOL
-    if _POOL is None:
-        _POOL = ThreadPoolExecutor(max_workers=_THREADS, thread_name_prefix="tumble")
+    """The pool, grown to ``_THREADS`` workers if :func:`using_threads` asked for more than it has."""
+    global _POOL, _POOL_SIZE
+    if _POOL_SIZE < _THREADS:
+        if _POOL is not None:
+            _POOL.shutdown(wait=False)
+        _POOL, _POOL_SIZE = ThreadPoolExecutor(max_workers=_THREADS, thread_name_prefix="tumble"), _THREADS
     return _POOL
 
 
