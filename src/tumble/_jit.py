@@ -133,14 +133,21 @@ def kernel(function=None, *, parallel: bool = False):
     return wrap(function) if function is not None else wrap
 
 
-def inline(function):
+def inline(function=None, *, into_callers: bool = False):
     """Compile a function that only compiled code calls: the helpers of ``math3d``, the solvers' passes, the
     collision routines. Without Python or C wrappers (:class:`_Helper`).
 
     Compiled as its own function and left to LLVM to inline: Numba's IR-level ``inline="always"`` made the
-    contact kernels compile 30 % slower for no measurable gain at run time.
+    contact kernels compile 30 % slower for no measurable gain at run time. ``into_callers=True`` asks for it where
+    a call costs more than the work: a compiled call reference-counts every array it receives (atomic operations,
+    0.5 µs for a few dozen), which the free-body integrator paid once per body and step (``integrate.py``).
     """
-    return _compiled(function, _Helper, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+
+    def wrap(f):
+        options = {"inline": "always"} if into_callers else {}
+        return _compiled(f, _Helper, no_cpython_wrapper=True, no_cfunc_wrapper=True, **options)
+
+    return wrap(function) if function is not None else wrap
 
 
 def kernel_for(template, name: str, **names):
