@@ -6,7 +6,8 @@ Run from the repository root:
 
 ``tumbling``     one body, I = diag(1, 2, 3), ω₀ = (0.01, 5, 0.01), no gravity, 20 000 steps of 1 ms: steps/s and
                  the drift of energy and angular momentum, per integrator, tumble and MuJoCo side by side.
-``many_bodies``  4096 free spheres under gravity in one world, no collisions: body-steps per second.
+``many_bodies``  4096 free spheres under gravity in one world, no collisions: body-steps per second; then the same
+                 scene at 1 000, 10 000 and 100 000 bodies, 10⁷ body-steps a call (the cost per body should be flat).
 ``cold_start``   ``import tumble`` and the first ``step``/``simulate`` in a fresh process, Numba cache cold
                  and warm.
 ``pile``, ``pyramid``, ``cubes``, ``big_pyramid``
@@ -91,6 +92,8 @@ class Sizes:
     bodies: int = 4096
     body_steps: int = 1000
     mujoco_seconds: float = 2.0  # wall time of one timed MuJoCo run in ``many_bodies``
+    scaling_bodies: tuple[int, ...] = (1_000, 10_000, 100_000)  # ``many_bodies`` again at these sizes
+    scaling_body_steps: int = 10_000_000  # body-steps per call at each of them
     repeat: int = 7
     cold_start: bool = True
     cold_start_bodies: int = 64
@@ -114,7 +117,8 @@ class Sizes:
 FULL = Sizes()
 QUICK = Sizes(
     tumbling_steps=200, record_every=100, bodies=64, body_steps=50, mujoco_seconds=0.02, repeat=1,
-    cold_start=False, cold_start_bodies=8, pile_boxes=27, pile_seconds=0.2, pyramid_base=4, pyramid_seconds=0.2,
+    cold_start=False, cold_start_bodies=8, scaling_bodies=(16, 64), scaling_body_steps=3200, pile_boxes=27,
+    pile_seconds=0.2, pyramid_base=4, pyramid_seconds=0.2,
     cubes_boxes=(8, 27), cubes_seconds=0.2, big_pyramid_base=6, big_pyramid_seconds=0.2, chain_links=4,
     chain_seconds=0.2, quadrotor_seconds=0.2, rotorpy_seconds=0.2, build_bodies=(100, 400), build_joints=(100, 400),
     broad_phase_shapes=(50,),
@@ -430,6 +434,13 @@ def bench_many_bodies(sizes: Sizes = FULL) -> list[dict]:
     ]
     if peers.have_mujoco():
         contenders += [_mujoco_contender(sizes, disable_contact=flag) for flag in (False, True)]
+    for bodies in sizes.scaling_bodies:  # the same scene at other sizes, the same body-steps per call
+        scaling_build_s, scaled = _timed(_many_bodies_world, bodies)
+        for integrator in ("auto", "symplectic"):
+            steps = max(1, sizes.scaling_body_steps // bodies)
+            contender = _tumble_contender(scaled, integrator, threads, steps, scaling_build_s)
+            contender.row["config"] = "no contacts, scaling"
+            contenders.append(contender)
     for c in contenders:
         first = c.run()
         c.row.setdefault("first_call_s", first)
@@ -577,6 +588,13 @@ def check_targets(results: dict[str, list[dict]]) -> list[dict]:
         if row is not None and one is not None and threads > 1:
             gain = row["body_steps_per_s"] / one["body_steps_per_s"]
             add(f"{row['bodies']} bodies, {integrator}: {threads} threads over 1 (x)", gain, ">= 1.7", gain >= 1.7)
+        scaling = sorted((r for r in many if r["config"] == "no contacts, scaling" and r["integrator"] == integrator),
+                         key=lambda r: r["bodies"])  # fmt: skip
+        if len(scaling) > 1:
+            small, large = scaling[0], scaling[-1]
+            growth = small["body_steps_per_s"] / large["body_steps_per_s"]
+            label = f"{integrator}: time per body-step at {large['bodies']} bodies over {small['bodies']} (x)"
+            add(label, growth, "<= 1.5 (flat)", growth <= 1.5)
     targets += _contact_targets(results)
     for row in results.get("cold_start", []):
         if row["order"] != "step first":

@@ -20,7 +20,7 @@ from benchmarks import build, joints, peers, quadrotor, run  # noqa: E402
 
 TINY = run.Sizes(
     tumbling_steps=40, record_every=10, bodies=8, body_steps=5, mujoco_seconds=0.002, repeat=1,
-    cold_start=False, cold_start_bodies=2,
+    cold_start=False, cold_start_bodies=2, scaling_bodies=(4, 16), scaling_body_steps=64,
 )  # fmt: skip
 
 
@@ -63,7 +63,11 @@ def test_many_bodies_rows():
     tumble_rows = [r for r in rows if r["engine"] == "tumble"]
     assert {r["integrator"] for r in tumble_rows} == {"auto", "symplectic"}
     assert 1 in {r["threads"] for r in tumble_rows}
-    assert all(r["bodies"] == TINY.bodies for r in rows)
+    scaling = [r for r in tumble_rows if r["config"] == "no contacts, scaling"]
+    assert sorted((r["bodies"], r["steps"]) for r in scaling) == [(4, 16), (4, 16), (16, 4), (16, 4)]
+    assert all(r["bodies"] == TINY.bodies for r in rows if r not in scaling)
+    targets = {t["target"] for t in run.check_targets({"many_bodies": rows})}
+    assert "symplectic: time per body-step at 16 bodies over 4 (x)" in targets
 
 
 def test_targets_table_and_csv(tmp_path):
