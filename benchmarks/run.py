@@ -432,6 +432,8 @@ def bench_many_bodies(sizes: Sizes = FULL) -> list[dict]:
         for integrator in ("auto", "symplectic")
         for count in sorted({threads, 1}, reverse=True)
     ]
+    # What auto costs where it runs RK4 (a body with torque, damping or an anisotropic spin): the same spheres.
+    contenders.append(_tumble_contender(world, "rk4", threads, sizes.body_steps, build_s))
     if peers.have_mujoco():
         contenders += [_mujoco_contender(sizes, disable_contact=flag) for flag in (False, True)]
     for bodies in sizes.scaling_bodies:  # the same scene at other sizes, the same body-steps per call

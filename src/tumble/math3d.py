@@ -190,6 +190,21 @@ def quat_integrate(q, w, h):
 
 
 @inline
+def quat_exp(w, h):
+    """``exp(½ ω h)``: the rotation by the angle ``|ω| h`` about ``ω``, as a unit quaternion."""
+    speed = math.sqrt(dot(w, w))
+    half = 0.5 * speed * h
+    if not math.isfinite(half):  # an overflowed state: NaN, which the step rejects (plain Python would raise)
+        return (math.nan, math.nan, math.nan, math.nan)
+    # sin(half) / speed → h / 2 as speed → 0; the series keeps full precision below 1e-4 rad
+    if abs(half) < 1e-4:
+        s = 0.5 * h * (1.0 - half * half / 6.0)
+    else:
+        s = math.sin(half) / speed
+    return (math.cos(half), w[0] * s, w[1] * s, w[2] * s)
+
+
+@inline
 def quat_is_finite(q):
     return math.isfinite(q[0]) and math.isfinite(q[1]) and math.isfinite(q[2]) and math.isfinite(q[3])
 

@@ -18,6 +18,7 @@ class Integrator(IntEnum):
     SYMPLECTIC = 1  # semi-implicit Euler, gyroscopic term by one implicit Newton step
     RK4 = 2  # classical Runge-Kutta on (x, q, p, L), quaternion renormalised
     MIDPOINT = 3  # Lie-Poisson implicit midpoint with the Cayley map: E and L conserved to round-off
+    EXACT_OR_RK4 = 4  # "auto" on free bodies: the exact flight where it has a closed form, RK4 elsewhere
 
 
 INTEGRATOR_NAMES = {
@@ -69,9 +70,10 @@ class Params:
     solver: SolverSettings = field(default_factory=lambda: DEFAULT_SOLVER)
 
     def resolve_integrator(self, has_constraints: bool) -> Integrator:
-        """``"auto"``: RK4 in momentum form for free bodies (L exactly constant without torque, energy
-        to ~1e-11 over 20 s at dt = 1e-3, see docs/integrators.md); semi-implicit Euler once contacts or
-        joints couple bodies."""
+        """``"auto"``: for free bodies, the exact flight of those whose motion has a closed form (constant force, no
+        torque, no damping, isotropic inertia or no spin) and RK4 in momentum form for the others (L exactly
+        constant without torque, energy to ~1e-11 over 20 s at dt = 1e-3, see docs/integrators.md); semi-implicit
+        Euler once contacts or joints couple bodies."""
         if self.integrator == "auto":
-            return Integrator.SYMPLECTIC if has_constraints else Integrator.RK4
+            return Integrator.SYMPLECTIC if has_constraints else Integrator.EXACT_OR_RK4
         return INTEGRATOR_NAMES[self.integrator]

@@ -15,7 +15,18 @@ from __future__ import annotations
 import math
 
 from .._jit import inline
-from ..math3d import add, add_scaled, cross, dot, mat_column, quat_mul, quat_normalize, quat_rotate, quat_to_mat33
+from ..math3d import (
+    add,
+    add_scaled,
+    cross,
+    dot,
+    mat_column,
+    quat_exp,
+    quat_mul,
+    quat_normalize,
+    quat_rotate,
+    quat_to_mat33,
+)
 from .joints import JointType
 from .model import (
     AXIS,
@@ -70,21 +81,6 @@ _FREE = int(JointType.FREE)
 def joint_quat(q, start):
     """The unit quaternion stored at ``q[start:start + 4]``."""
     return quat_normalize((q[start], q[start + 1], q[start + 2], q[start + 3]))
-
-
-@inline
-def quat_exp(w, h):
-    """``exp(½ ω h)``: the rotation by the angle ``|ω| h`` about ``ω``, as a unit quaternion."""
-    speed = math.sqrt(dot(w, w))
-    half = 0.5 * speed * h
-    if not math.isfinite(half):  # an overflowed state: NaN, which the step rejects (plain Python would raise)
-        return (math.nan, math.nan, math.nan, math.nan)
-    # sin(half) / speed → h / 2 as speed → 0; the series keeps full precision below 1e-4 rad
-    if abs(half) < 1e-4:
-        s = 0.5 * h * (1.0 - half * half / 6.0)
-    else:
-        s = math.sin(half) / speed
-    return (math.cos(half), w[0] * s, w[1] * s, w[2] * s)
 
 
 @inline

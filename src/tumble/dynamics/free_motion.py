@@ -20,6 +20,10 @@ every step would not do (measured: 1e-11 relative drift over 20 000 steps from t
   the Dzhanibekov body), the price of never blowing up.
 - ``rk4_step``: classical Runge–Kutta on ``(x, q, v, L)``; ``L`` is integrated directly, so a body with no
   torque keeps ``L`` exactly; the quaternion is renormalised once at the end. Fourth order.
+- ``flight_step``: the exact motion of a body whose loads give a closed form: a constant force, no torque, no
+  damping, and a spin that stays constant (``ω = I⁻¹ L`` with an isotropic ``I``, or no spin). The parabola
+  ``x + h (v + ½ h F/m)`` and the turn ``exp(½ h ω) ⊗ q``, both exact; ``"auto"`` takes it for such bodies and
+  RK4 for the others.
 - ``midpoint_step``: the implicit midpoint rule on the body-frame momentum ``Π = Rᵀ L`` (a Lie–Poisson
   integrator) with the Cayley map for the orientation, inside a Strang splitting of the force and torque
   kicks. ``Π' = Π + h Π_m × I⁻¹Π_m`` is exactly ``Π' = cay(−h Ω̂_m) Π``, so with ``R' = R cay(h Ω̂_m)`` the
@@ -46,6 +50,7 @@ from ..math3d import (
     mat_vec,
     quat_add_scaled,
     quat_derivative,
+    quat_exp,
     quat_integrate,
     quat_mul,
     quat_normalize,
@@ -173,6 +178,39 @@ def rk4_step(x, q, v, angmom, inv_m, inertia, inv_inertia, force, torque, c_lin,
     )
     q_new = quat_normalize(quat_add_scaled(q, dq, sixth))
     return x_new, q_new, v_new, l_new
+
+
+@inline
+def flies_freely(torque, c_lin, c_ang, inv_inertia, angmom):
+    """Whether :func:`flight_step` is exact for this body: no torque, no damping, and ``ω = I⁻¹ L`` constant,
+    which holds when ``I`` is isotropic (sphere, cube) or the body does not spin (``L = 0`` stays 0)."""
+    if torque[0] != 0.0 or torque[1] != 0.0 or torque[2] != 0.0 or c_lin != 0.0 or c_ang != 0.0:
+        return False
+    if angmom[0] == 0.0 and angmom[1] == 0.0 and angmom[2] == 0.0:
+        return True
+    m = inv_inertia
+    off_diagonal = abs(m[1]) + abs(m[2]) + abs(m[3]) + abs(m[5]) + abs(m[6]) + abs(m[7])
+    return off_diagonal == 0.0 and m[0] == m[4] and m[4] == m[8]
+
+
+@inline
+def flight_step(x, q, v, angmom, inv_m, force, turn, h):
+    """The exact step of a body for which :func:`flies_freely` holds, ``turn`` being ``exp(½ h ω)``: the parabola
+    under the constant force, and ``q̇ = ½ ω ⊗ q`` solved in closed form, ``q(t + h) = exp(½ h ω) ⊗ q(t)``.
+    ``L`` does not change; a body that does not spin keeps its ``q`` bit for bit."""
+    a = scale(force, inv_m)
+    x_new = add_scaled(x, add_scaled(v, a, 0.5 * h), h)  # not h² a / 2: h² alone may overflow
+    v_new = add_scaled(v, a, h)
+    q_new = q
+    if angmom[0] != 0.0 or angmom[1] != 0.0 or angmom[2] != 0.0:
+        q_new = quat_normalize(quat_mul(turn, q))
+    return x_new, q_new, v_new, angmom
+
+
+@inline
+def spin_turn(inv_inertia, angmom, h):
+    """``exp(½ h ω)`` for the constant spin ``ω = I⁻¹ L`` of an isotropic body (one step's turn)."""
+    return quat_exp(scale(angmom, inv_inertia[0]), h)
 
 
 @inline

@@ -16,6 +16,7 @@ replays exactly the steps that all bodies completed, so the world stops at its l
 from __future__ import annotations
 
 import contextlib
+import math
 import os
 import warnings
 from concurrent.futures import ThreadPoolExecutor
@@ -28,7 +29,7 @@ from ..math3d import add_scaled, is_finite3, load3, load4, load33, quat_is_finit
 from ..model import Model
 from ..params import Integrator
 from ..state import State
-from .free_motion import euler_step, midpoint_step, rk4_step, symplectic_step
+from .free_motion import euler_step, flies_freely, flight_step, midpoint_step, rk4_step, spin_turn, symplectic_step
 
 __all__ = ["Recording", "advance_free_bodies", "PARALLEL_MIN_WORK", "thread_count", "threads", "using_threads"]
 
@@ -114,6 +115,7 @@ def _body_steps(i, body, start, acts, rec, h, n_steps, method, record_every):
     inv_m, inertia, inv_inertia, c_lin, c_ang, weight, steady_torque, applied_force, applied_torque = body
     x, q, v, l = start
     failed = -1
+    turn, turn_for = (1.0, 0.0, 0.0, 0.0), (math.nan, math.nan, math.nan)  # exp(½ h ω) of the flight, and its L
     for s in range(n_steps):
         f = (weight[0] + applied_force[0], weight[1] + applied_force[1], weight[2] + applied_force[2])
         t = (steady_torque[0] + applied_torque[0], steady_torque[1] + applied_torque[1],
@@ -121,13 +123,18 @@ def _body_steps(i, body, start, acts, rec, h, n_steps, method, record_every):
         if s > 0:
             f = weight
             t = steady_torque
-        if method == 0:
+        # method: an Integrator code; 4 (auto) flies a body exactly where its motion has a closed form, else RK4.
+        if method == 4 and acts is None and flies_freely(t, c_lin, c_ang, inv_inertia, l):
+            if l[0] != turn_for[0] or l[1] != turn_for[1] or l[2] != turn_for[2]:  # L is constant in flight
+                turn, turn_for = spin_turn(inv_inertia, l, h), l
+            xn, qn, vn, ln = flight_step(x, q, v, l, inv_m, f, turn, h)
+        elif method == 0:
             xn, qn, vn, ln = euler_step(x, q, v, l, inv_m, inertia, inv_inertia, f, t, c_lin, c_ang, h, acts, i, s * h)
         elif method == 1:
             xn, qn, vn, ln = symplectic_step(
                 x, q, v, l, inv_m, inertia, inv_inertia, f, t, c_lin, c_ang, h, acts, i, s * h
             )
-        elif method == 2:
+        elif method == 2 or method == 4:
             xn, qn, vn, ln = rk4_step(x, q, v, l, inv_m, inertia, inv_inertia, f, t, c_lin, c_ang, h, acts, i, s * h)
         else:
             xn, qn, vn, ln = midpoint_step(
