@@ -144,6 +144,6 @@ def test_the_free_body_integrator_compiles_its_per_body_calls_into_the_row_loop(
     are compiled into their callers (Numba's ``inline="always"``), or every body would pay that once per call."""
     from tumble.dynamics import integrate
 
-    for helper in (integrate._advance_body, integrate._body_steps, integrate._save_row):
+    for helper in (integrate.advance_rows, integrate._body_steps, integrate._save_row):
         assert helper.targetoptions.get("inline") == "always", helper.py_func.__name__
     assert "inline" not in math3d.dot.targetoptions  # the other helpers are left to LLVM

@@ -31,7 +31,15 @@ from ..params import Integrator
 from ..state import State
 from .free_motion import euler_step, flies_freely, flight_step, midpoint_step, rk4_step, spin_turn, symplectic_step
 
-__all__ = ["Recording", "advance_free_bodies", "PARALLEL_MIN_WORK", "thread_count", "threads", "using_threads"]
+__all__ = [
+    "Recording",
+    "advance_free_bodies",
+    "advance_rows",
+    "PARALLEL_MIN_WORK",
+    "thread_count",
+    "threads",
+    "using_threads",
+]
 
 # Below this many body-steps per call the threads cost more than they save (measured: one body for 20 000
 # steps ran 5 % slower split across threads).
@@ -81,42 +89,63 @@ def empty_recording(body_count: int) -> Recording:
 
 
 @inline(into_callers=True)
-def _advance_body(i, bodies, gravity, force, torque, acts, pos, quat, linvel, angmom, rec, h, n_steps, method,
-                  record_every):  # fmt: skip
-    """Carry body ``i`` through ``n_steps``; return the index of the failing step, or -1.
+def advance_rows(first, last, bodies, gravity, force, torque, acts, pos, quat, linvel, angmom, rec, failed_step, h,
+                 n_steps, method, record_every):  # fmt: skip
+    """Carry bodies ``first..last-1`` through ``n_steps``: ``failed_step[i]`` is the index of the step in which body
+    ``i`` failed, or -1; a failed body's row keeps its last good state.
 
-    Compiled into its callers (the row loop, ``flight.native``), and its steps take the body's constants and state as
-    tuples, not the arrays they come from: a compiled call reference-counts every array it receives (atomic
-    operations), which cost 1 µs a body and call before the first step (4096 bodies: 4.1 ms a call, 1.6 ms since;
-    one step of their physics takes 0.3 ms). A body without actuators runs the steps compiled with ``acts=None``, in
-    which they cost nothing.
+    The loop over the bodies is in here, and its body hands the per-body steps no array: a function compiled into a
+    loop (Numba's ``inline="always"``) takes a reference to every array it is given at each pass, two atomic
+    operations per array, which LLVM does not remove across the steps' loop. Given the model's, the actuators' and the
+    recording's arrays (about 50), that cost 440 ns a body and call whatever the number of steps (1.8 ms a
+    ``step()`` of 4096 bodies, whose physics takes 0.1–0.6 ms). Recording stays here too, between runs of
+    ``record_every`` steps. Each body's steps take its constants and state as tuples; a body without actuators runs
+    the steps compiled with ``acts=None``, in which they cost nothing.
     """
-    # Gravity and the constant loads act in every step; applied loads in the first step only.
-    weight = add_scaled(load3(bodies.constant_force, i), (gravity[0], gravity[1], gravity[2]), bodies.mass[i])
-    body = (bodies.inv_mass[i], load33(bodies.inertia_local, i), load33(bodies.inv_inertia_local, i),
-            bodies.linear_damping[i], bodies.angular_damping[i], weight, load3(bodies.constant_torque, i),
-            load3(force, i), load3(torque, i))  # fmt: skip
-    start = (load3(pos, i), load4(quat, i), load3(linvel, i), load3(angmom, i))
-    if acts.driven[i]:
-        failed, x, q, v, l = _body_steps(i, body, start, acts, rec, h, n_steps, method, record_every)
-    else:
-        failed, x, q, v, l = _body_steps(i, body, start, None, rec, h, n_steps, method, record_every)
-    store3(pos, i, x)
-    store4(quat, i, q)
-    store3(linvel, i, v)
-    store3(angmom, i, l)
-    return failed
+    g = (gravity[0], gravity[1], gravity[2])
+    for i in range(first, last):
+        failed_step[i] = -1
+        if not bodies.is_dynamic[i]:
+            _copy_static_rows(i, pos, quat, linvel, angmom, rec, n_steps, record_every)
+            continue
+        # Gravity and the constant loads act in every step; applied loads in the first step only.
+        weight = add_scaled(load3(bodies.constant_force, i), g, bodies.mass[i])
+        body = (bodies.inv_mass[i], load33(bodies.inertia_local, i), load33(bodies.inv_inertia_local, i),
+                bodies.linear_damping[i], bodies.angular_damping[i], weight, load3(bodies.constant_torque, i),
+                load3(force, i), load3(torque, i))  # fmt: skip
+        state = (load3(pos, i), load4(quat, i), load3(linvel, i), load3(angmom, i))
+        turn = ((1.0, 0.0, 0.0, 0.0), (math.nan, math.nan, math.nan))  # auto's flight: exp(½ h ω), and the L of ω
+        done, failed = 0, -1
+        while done < n_steps and failed < 0:
+            end = min(done + record_every, n_steps) if record_every > 0 else n_steps
+            if acts.driven[i]:
+                failed, state, turn = _body_steps(i, body, state, turn, acts, h, done, end, method)
+            else:
+                failed, state, turn = _body_steps(i, body, state, turn, None, h, done, end, method)
+            if failed < 0 and record_every > 0 and end % record_every == 0:
+                frame = end // record_every - 1
+                store3(rec.pos[frame], i, state[0])
+                store4(rec.quat[frame], i, state[1])
+                store3(rec.linvel[frame], i, state[2])
+                store3(rec.angmom[frame], i, state[3])
+            done = end
+        store3(pos, i, state[0])
+        store4(quat, i, state[1])
+        store3(linvel, i, state[2])
+        store3(angmom, i, state[3])
+        failed_step[i] = failed
 
 
 @inline(into_callers=True)
-def _body_steps(i, body, start, acts, rec, h, n_steps, method, record_every):
-    """The steps of :func:`_advance_body` from the state ``start``, with its actuators ``acts`` or ``None``: the
-    failing step (or -1) and the last good state."""
+def _body_steps(i, body, state, turn, acts, h, first_step, end_step, method):
+    """Steps ``first_step..end_step-1`` of body ``i`` from ``state``, with its actuators ``acts`` or ``None``:
+    ``(failing step or -1, last good state, turn)``. ``turn`` carries auto's flight rotation ``exp(½ h ω)`` with the
+    ``L`` it was computed for, so that a flight computes it once, not at every step or recorded frame."""
     inv_m, inertia, inv_inertia, c_lin, c_ang, weight, steady_torque, applied_force, applied_torque = body
-    x, q, v, l = start
+    x, q, v, l = state
+    spin, spin_for = turn
     failed = -1
-    turn, turn_for = (1.0, 0.0, 0.0, 0.0), (math.nan, math.nan, math.nan)  # exp(½ h ω) of the flight, and its L
-    for s in range(n_steps):
+    for s in range(first_step, end_step):
         f = (weight[0] + applied_force[0], weight[1] + applied_force[1], weight[2] + applied_force[2])
         t = (steady_torque[0] + applied_torque[0], steady_torque[1] + applied_torque[1],
              steady_torque[2] + applied_torque[2])  # fmt: skip
@@ -125,9 +154,9 @@ def _body_steps(i, body, start, acts, rec, h, n_steps, method, record_every):
             t = steady_torque
         # method: an Integrator code; 4 (auto) flies a body exactly where its motion has a closed form, else RK4.
         if method == 4 and acts is None and flies_freely(t, c_lin, c_ang, inv_inertia, l):
-            if l[0] != turn_for[0] or l[1] != turn_for[1] or l[2] != turn_for[2]:  # L is constant in flight
-                turn, turn_for = spin_turn(inv_inertia, l, h), l
-            xn, qn, vn, ln = flight_step(x, q, v, l, inv_m, f, turn, h)
+            if l[0] != spin_for[0] or l[1] != spin_for[1] or l[2] != spin_for[2]:  # L is constant in flight
+                spin, spin_for = spin_turn(inv_inertia, l, h), l
+            xn, qn, vn, ln = flight_step(x, q, v, l, inv_m, f, spin, h)
         elif method == 0:
             xn, qn, vn, ln = euler_step(x, q, v, l, inv_m, inertia, inv_inertia, f, t, c_lin, c_ang, h, acts, i, s * h)
         elif method == 1:
@@ -144,13 +173,7 @@ def _body_steps(i, body, start, acts, rec, h, n_steps, method, record_every):
             failed = s
             break
         x, q, v, l = xn, qn, vn, ln
-        if record_every > 0 and (s + 1) % record_every == 0:
-            frame = (s + 1) // record_every - 1
-            store3(rec.pos[frame], i, x)
-            store4(rec.quat[frame], i, q)
-            store3(rec.linvel[frame], i, v)
-            store3(rec.angmom[frame], i, l)
-    return failed, x, q, v, l
+    return failed, (x, q, v, l), (spin, spin_for)
 
 
 @inline
@@ -173,12 +196,8 @@ def _advance_rows_kernel(bodies, gravity, force, torque, acts, pos, quat, linvel
     """
     for i in range(first, last):
         _save_row(i, pos, quat, linvel, angmom, backup)
-        failed_step[i] = -1
-        if bodies.is_dynamic[i]:
-            failed_step[i] = _advance_body(i, bodies, gravity, force, torque, acts, pos, quat, linvel, angmom, rec,
-                                           h, n_steps, method, record_every)  # fmt: skip
-        else:
-            _copy_static_rows(i, pos, quat, linvel, angmom, rec, n_steps, record_every)
+    advance_rows(first, last, bodies, gravity, force, torque, acts, pos, quat, linvel, angmom, rec, failed_step, h,
+                 n_steps, method, record_every)  # fmt: skip
     first_failure = -1
     for i in range(first, last):
         if failed_step[i] >= 0 and (first_failure < 0 or failed_step[i] < first_failure):

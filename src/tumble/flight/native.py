@@ -5,7 +5,7 @@ wind) takes every step and flight in one call (:func:`fly_steps`).
 
 It does what the step-by-step path does, in the same order and with the same kernels: at each step's counted start
 time the flights that are due evaluate their reference (``reference_derivatives``) and the SE(3) law
-(``se3_rotor_speeds``) and command their rotors; every body takes one step of the same integrator (``_advance_body``
+(``se3_rotor_speeds``) and command their rotors; every body takes one step of the same integrator (``advance_rows``
 with one step); the motors advance by ``h``. The two paths fly bit for bit alike.
 """
 
@@ -18,7 +18,7 @@ import numpy as np
 
 from .._jit import kernel
 from ..dynamics.actuation import advance_motors
-from ..dynamics.integrate import _advance_body
+from ..dynamics.integrate import advance_rows
 from ..math3d import store3, store4
 from ..references import Circle, Hover, Lissajous, MinimumSnap
 from . import SE3Controller
@@ -167,6 +167,7 @@ def fly_steps(table, bodies, gravity, force, torque, zero, acts, pos, quat, linv
     h``, as ``tumble.control.StepClock`` counts. Returns ``(steps_done, failing_body, failing_flight)`` (-1: none);
     on a failure the bodies are as before that step, and ``speeds`` holds what a failing flight asked for."""
     integral = np.zeros(3)
+    failed_step = np.empty(pos.shape[0], np.int64)
     for s in range(n_steps):
         failing = command_flights(table, gravity, acts, pos, quat, linvel, angmom, origin_time + (origin_count + s) * h,
                                   h, ref, speeds, integral)  # fmt: skip
@@ -178,12 +179,11 @@ def fly_steps(table, bodies, gravity, force, torque, zero, acts, pos, quat, linv
             store4(backup[1], i, (quat[i, 0], quat[i, 1], quat[i, 2], quat[i, 3]))
             store3(backup[2], i, (linvel[i, 0], linvel[i, 1], linvel[i, 2]))
             store3(backup[3], i, (angmom[i, 0], angmom[i, 1], angmom[i, 2]))
+        loads_f, loads_t = (force, torque) if s == 0 else (zero, zero)
+        advance_rows(0, body_count, bodies, gravity, loads_f, loads_t, acts, pos, quat, linvel, angmom, no_recording,
+                     failed_step, h, 1, method, 0)  # fmt: skip
         for i in range(body_count):
-            if not bodies.is_dynamic[i]:
-                continue
-            loads_f, loads_t = (force, torque) if s == 0 else (zero, zero)
-            if _advance_body(i, bodies, gravity, loads_f, loads_t, acts, pos, quat, linvel, angmom, no_recording, h,
-                             1, method, 0) >= 0:  # fmt: skip
+            if failed_step[i] >= 0:
                 pos[:, :], quat[:, :], linvel[:, :], angmom[:, :] = backup[0], backup[1], backup[2], backup[3]
                 return s, i, -1
         advance_motors(acts, h)
