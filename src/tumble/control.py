@@ -139,6 +139,8 @@ class Controllers:
         Raises:
             SimulationError: a controller raised; the message names it and the time, the world is as it was.
         """
+        if not self._items:
+            return
         state = world.state
         for controller in self:
             if not controller._due(t, dt):
