@@ -350,6 +350,13 @@ def _require_unit_quaternions(name: str, value) -> None:
         raise ValueError(f"{name} holds a quaternion of norm {norms[np.argmax(np.abs(norms - 1.0))]!r}, not 1")
 
 
+def _require_quaternion(name: str, value) -> None:
+    """One unit quaternion: shape (4,) (an empty list passed the unit check, and a kernel read past it)."""
+    if np.shape(value) != (4,):
+        raise ValueError(f"{name} of shape {np.shape(value)}, expected (4,)")
+    _require_unit_quaternions(name, value)
+
+
 def _require_mass(mp) -> None:
     if not isinstance(mp, MassProperties):
         raise TypeError(f"mass properties are {type(mp).__name__}")
@@ -360,7 +367,7 @@ def _require_shape(spec) -> None:
     if not isinstance(spec, ShapeSpec) or not isinstance(spec.shape, _shapes.Shape):
         raise TypeError(f"{type(spec).__name__} holding {type(getattr(spec, 'shape', None)).__name__}, not a shape")
     as_vector3("position", spec.position)
-    _require_unit_quaternions("quat", spec.quat)
+    _require_quaternion("quat", spec.quat)
     as_material(spec.friction, spec.restitution, spec.rolling_resistance)
     as_filter("group", spec.group)
     as_filter("mask", spec.mask)
@@ -373,7 +380,7 @@ def _require_joint(spec) -> None:
     for name in ("local_anchor_a", "local_anchor_b"):
         as_vector3(name, getattr(spec, name))
     for name in ("local_frame_a", "local_frame_b"):
-        _require_unit_quaternions(name, getattr(spec, name))
+        _require_quaternion(name, getattr(spec, name))
     drive = np.asarray(spec.drive)
     if drive.shape != (8,):
         raise ValueError(f"drive of shape {drive.shape}, expected (8,)")
