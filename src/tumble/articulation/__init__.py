@@ -18,6 +18,19 @@ from .articulation import Articulation, ArticulationTrajectory, Link
 from .joints import Ball, Fixed, Free, Joint, JointType, Prismatic, Revolute
 from .loops import LoopClosure
 
+
+def from_mjcf(path_or_xml) -> Articulation:
+    """The articulation of an MJCF model (a file path, or XML text starting with ``<``): its bodies, joints and
+    mass properties in generalised coordinates, ``q``/``qd`` in MuJoCo's ``qpos``/``qvel`` order and conventions,
+    starting at ``qpos0``; no contacts. What tumble does not simulate is named in one warning per element and
+    attribute (:class:`tumble.models.mjcf.MJCFWarning`); a file that cannot be read raises
+    :class:`tumble.models.mjcf.MJCFError` naming the file, element and line. See docs/model_files.md."""
+    from ..models.build import to_articulation
+    from ..models.mjcf import read_mjcf
+
+    return to_articulation(read_mjcf(path_or_xml))
+
+
 __all__ = [
     "Articulation",
     "ArticulationTrajectory",
@@ -30,4 +43,5 @@ __all__ = [
     "LoopClosure",
     "Prismatic",
     "Revolute",
+    "from_mjcf",
 ]

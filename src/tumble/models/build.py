@@ -1,0 +1,74 @@
+"""Builders: a :class:`~tumble.models.description.ModelDescription` into tumble objects.
+
+``to_articulation``: the generalised-coordinate view. Each body becomes one link per joint: a body with several
+joints is a chain whose intermediate links are massless and whose last link carries the body's name and mass
+properties; a body without joints is welded to its parent (``Fixed``). tumble's link frame is the joint frame, so a
+joint at ``pos`` in its body puts the link's origin there; the body's mass properties and its children are placed
+relative to it. MuJoCo measures a hinge or slide from its ``ref`` (the coordinate at the model's pose), so the link
+frame is turned (moved) back by ``ref``: ``q`` then equals MuJoCo's ``qpos`` and ``qd`` its ``qvel``, entry by entry,
+and the articulation starts at MuJoCo's ``qpos0``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..articulation import Articulation, Ball, Fixed, Free, Prismatic, Revolute
+from ..rotation import quat_from_axis_angle, quat_multiply, quat_rotate
+from .description import JointDescription, ModelDescription
+
+__all__ = ["to_articulation"]
+
+_IDENTITY = np.array([1.0, 0.0, 0.0, 0.0])
+_WELD = JointDescription(None, "fixed", np.zeros(3), np.zeros(3), None, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0)
+
+
+def _link_joint(joint: JointDescription, position: np.ndarray, orientation: np.ndarray):
+    """tumble's joint for ``joint`` and its link frame, turned (or moved) back by ``ref``."""
+    if joint.type == "hinge":
+        return Revolute(joint.axis), position, quat_multiply(orientation, quat_from_axis_angle(joint.axis, -joint.ref))
+    if joint.type == "slide":
+        return Prismatic(joint.axis), position - joint.ref * quat_rotate(orientation, joint.axis), orientation
+    if joint.type == "ball":
+        return Ball(), position, orientation
+    if joint.type == "free":
+        return Free(), position, orientation
+    return Fixed(), position, orientation
+
+
+def to_articulation(model: ModelDescription) -> Articulation:
+    """The articulation of ``model``'s bodies (no contacts): gravity from the model, base at the world origin."""
+    art = Articulation(gravity=model.gravity, name=model.name)
+    last_link: dict[int, tuple[int | None, np.ndarray]] = {-1: (None, np.zeros(3))}
+    initial: list[tuple[int, float]] = []
+    for index, body in enumerate(model.bodies):
+        parent, parent_anchor = last_link[body.parent]
+        joints = body.joints or (_WELD,)
+        for k, joint in enumerate(joints):
+            last = k == len(joints) - 1
+            if k == 0:  # the body frame in the parent's last link frame, then the joint's anchor in it
+                position = body.pos - parent_anchor + quat_rotate(body.quat, joint.pos)
+                orientation = body.quat
+            else:  # the previous joint's link frame is the body frame moved to that joint's anchor
+                position, orientation = joint.pos - joints[k - 1].pos, _IDENTITY
+            link_joint, position, orientation = _link_joint(joint, position, orientation)
+            properties = body.mass_properties
+            if last and properties is not None:
+                properties = properties.transformed(translation=-joint.pos)
+            name = body.name if last else _chain_name(body.name, joint.name, k)
+            parent = art.add_link(link_joint, parent=parent, position=position, orientation=orientation,
+                                  mass_properties=properties if last else None, damping=joint.damping,
+                                  name=name)  # fmt: skip
+            if joint.type in ("hinge", "slide") and joint.ref != 0.0:
+                initial.append((parent, joint.ref))
+        last_link[index] = (parent, joints[-1].pos)
+    for link, ref in initial:
+        art.set_joint(link, q=ref)
+    return art
+
+
+def _chain_name(body: str | None, joint: str | None, k: int) -> str | None:
+    """The name of an intermediate link of a body's chain: ``body/joint`` (``body/joint0`` for an unnamed joint)."""
+    if body is None:
+        return None
+    return f"{body}/{joint if joint is not None else f'joint{k}'}"

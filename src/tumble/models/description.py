@@ -1,0 +1,84 @@
+"""A model file as plain data: bodies in tree order with their frames, joints, geoms and mass properties.
+
+The MJCF reader produces it (``models/mjcf``), the builders consume it (``models/build.py``); the URDF reader will
+produce the same. Everything is resolved: defaults applied, angles in radians, orientations as unit quaternions,
+mass properties computed. Frames follow MuJoCo: a body's ``pos``/``quat`` place it in its parent's frame, its
+joints' ``pos``/``axis`` and its geoms are in its own frame.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..mass import MassProperties
+
+__all__ = ["BodyDescription", "GeomDescription", "JointDescription", "ModelDescription"]
+
+
+@dataclass(frozen=True)
+class JointDescription:
+    """One joint of a body. ``type``: ``"hinge"``, ``"slide"``, ``"ball"`` or ``"free"``."""
+
+    name: str | None
+    type: str
+    pos: np.ndarray  # (3,) [m], body frame
+    axis: np.ndarray  # (3,) unit, body frame (hinge, slide)
+    range: tuple[float, float] | None  # [rad] or [m]; None: unlimited
+    ref: float  # the coordinate at the model's pose (qpos0) [rad] or [m]
+    springref: float  # the spring's rest coordinate
+    stiffness: float
+    damping: float
+    armature: float
+    frictionloss: float
+    line: int
+
+
+@dataclass(frozen=True)
+class GeomDescription:
+    """One geom of a body, in the body frame. ``size`` is MuJoCo's (half sizes, radius, half length)."""
+
+    name: str | None
+    type: str
+    size: np.ndarray  # (3,)
+    pos: np.ndarray  # (3,)
+    quat: np.ndarray  # (4,)
+    group: int
+    contype: int
+    conaffinity: int
+    friction: np.ndarray  # (3,) sliding, torsional, rolling
+    line: int
+
+
+@dataclass(frozen=True)
+class BodyDescription:
+    """One body. ``parent`` indexes ``ModelDescription.bodies`` (-1: the world); parents come first."""
+
+    name: str | None
+    parent: int
+    pos: np.ndarray  # (3,) in the parent's frame
+    quat: np.ndarray  # (4,)
+    mass_properties: MassProperties | None  # body frame; None: massless
+    joints: tuple[JointDescription, ...]
+    geoms: tuple[GeomDescription, ...]
+    line: int
+
+
+@dataclass(frozen=True)
+class ModelDescription:
+    """A whole model: the bodies (without the world), the world's own geoms, and the simulation options."""
+
+    name: str
+    source: str
+    bodies: tuple[BodyDescription, ...]
+    world_geoms: tuple[GeomDescription, ...]
+    gravity: np.ndarray = field(default_factory=lambda: np.array([0.0, 0.0, -9.81]))
+    timestep: float = 0.002
+    integrator: str = "Euler"
+
+    def body_index(self, name: str) -> int:
+        for index, body in enumerate(self.bodies):
+            if body.name == name:
+                return index
+        raise KeyError(f"no body named {name!r} in {self.source}")

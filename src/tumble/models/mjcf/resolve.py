@@ -1,0 +1,421 @@
+"""From the MJCF tree to a :class:`~tumble.models.description.ModelDescription`: ``compiler`` settings, ``default``
+classes, and every body, joint and geom with its attributes resolved (MuJoCo's rules, MuJoCo's defaults).
+
+An element's attributes are its class's defaults overlaid by its own; its class is its ``class`` attribute, else the
+``childclass`` of the nearest body that has one, else ``main`` (the top ``<default>``). A nested ``<default
+class=...>`` starts from its parent class. What tumble does not model (or not yet) is reported by one warning per
+element and attribute, naming the first line; what cannot be read is an :class:`~.xml.MJCFError` naming the file,
+element and line.
+"""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+
+import numpy as np
+
+from ...mass import MassProperties
+from ...rotation import quat_to_matrix
+from ..description import BodyDescription, GeomDescription, JointDescription, ModelDescription
+from .frames import ORIENTATIONS, orientation, quat_z_to
+from .inertia import VOLUME_TYPES, bounded, geom_mass_properties, geom_volume
+from .xml import Node
+
+__all__ = ["MJCFWarning", "describe"]
+
+
+class MJCFWarning(UserWarning):
+    """Part of a model file that tumble reads but does not simulate (or not yet)."""
+
+
+# Elements that hold nothing an articulation simulates: read past without a word.
+_SILENT = {"site", "camera", "light", "visual", "statistic", "size", "asset", "texture", "material", "hfield",
+           "skin", "custom", "extension"}  # fmt: skip
+# Attributes that only matter to collision or drawing, which an articulation has no use for.
+_COSMETIC = {"rgba", "material", "group", "user", "margin", "gap", "solref", "solimp", "solmix", "priority", "condim",
+             "contype", "conaffinity", "friction", "solreflimit", "solimplimit", "solreffriction", "solimpfriction",
+             "class", "childclass", "name", "texture", "emission", "specular", "shininess", "reflectance"}  # fmt: skip
+_JOINT = {"type", "pos", "axis", "range", "limited", "ref", "springref", "stiffness", "damping", "armature",
+          "frictionloss", "actuatorfrcrange", "actuatorfrclimited"}  # fmt: skip
+_GEOM = {"type", "size", "fromto", "pos", "mass", "density", "shellinertia", "mesh", *ORIENTATIONS}
+_BODY = {"pos", *ORIENTATIONS}
+_INERTIAL = {"pos", "mass", "diaginertia", "fullinertia", *ORIENTATIONS}
+_COMPILER_READ = {"angle", "eulerseq", "inertiafromgeom", "boundmass", "boundinertia", "autolimits",
+                  "inertiagrouprange", "coordinate", "settotalmass", "meshdir", "assetdir", "texturedir",
+                  "strippath"}  # fmt: skip
+_COMPILER_SWITCHES = {"balanceinertia", "fusestatic", "discardvisual", "alignfree"}  # fine while "false"
+_JOINT_TYPES = ("hinge", "slide", "ball", "free")
+_GEOM_TYPES = ("plane", "hfield", "sphere", "capsule", "ellipsoid", "cylinder", "box", "mesh", "sdf")
+
+
+@dataclass
+class _Compiler:
+    degrees: bool = True
+    eulerseq: str = "xyz"
+    inertiafromgeom: str = "auto"
+    boundmass: float = 0.0
+    boundinertia: float = 0.0
+    autolimits: bool = True
+    inertiagrouprange: tuple[int, int] = (0, 5)
+    settotalmass: float = -1.0
+
+
+@dataclass
+class _Reader:
+    """The state of one read: compiler settings, default classes, and the warnings gathered."""
+
+    compiler: _Compiler = field(default_factory=_Compiler)
+    defaults: dict[str, dict[str, dict[str, str]]] = field(default_factory=lambda: {"main": {}})
+    notes: dict[tuple[str, str], list[Node]] = field(default_factory=dict)
+
+    def note(self, node: Node, what: str, message: str) -> None:
+        """Gather a warning; one is issued per element and attribute, at the end."""
+        self.notes.setdefault((f"<{node.tag}> {what}", message), []).append(node)
+
+    def warn_all(self, source: str) -> None:
+        for (what, message), nodes in self.notes.items():
+            more = f" and {len(nodes) - 1} more" if len(nodes) > 1 else ""
+            warnings.warn(f"{source}: {what} (line {nodes[0].line}{more}): {message}", MJCFWarning, stacklevel=4)
+
+
+# --- attributes --------------------------------------------------------------------------------------
+
+
+def _numbers(node: Node, attrib: dict[str, str], name: str, count: int | tuple[int, ...], default=None):
+    text = attrib.get(name)
+    if text is None:
+        return None if default is None else np.array(default, dtype=float)
+    try:
+        values = np.array([float(word) for word in text.split()], dtype=float)
+    except ValueError:
+        raise node.error(f"{name}={text!r} is not a list of numbers") from None
+    counts = (count,) if isinstance(count, int) else count
+    if values.size not in counts or not np.all(np.isfinite(values)):
+        wanted = " or ".join(str(c) for c in counts)
+        raise node.error(f"{name}={text!r} must be {wanted} finite numbers")
+    return values
+
+
+def _number(node: Node, attrib: dict[str, str], name: str, default: float, nonnegative: bool = False) -> float:
+    value = float(_numbers(node, attrib, name, 1, [default])[0])
+    if nonnegative and value < 0:
+        raise node.error(f"{name}={attrib[name]!r} must be >= 0")
+    return value
+
+
+def _keyword(node: Node, attrib: dict[str, str], name: str, default: str, allowed: tuple[str, ...]) -> str:
+    value = attrib.get(name, default)
+    if value not in allowed:
+        raise node.error(f"{name}={value!r} must be one of {', '.join(allowed)}")
+    return value
+
+
+def _flag(node: Node, attrib: dict[str, str], name: str, default: str) -> str:
+    return _keyword(node, attrib, name, default, ("true", "false", "auto"))
+
+
+def _frame_quat(reader: _Reader, node: Node, attrib: dict[str, str]) -> np.ndarray:
+    given = [kind for kind in ORIENTATIONS if kind in attrib]
+    if len(given) > 1:
+        raise node.error(f"give at most one orientation, got {', '.join(given)}")
+    if not given:
+        return np.array([1.0, 0.0, 0.0, 0.0])
+    kind = given[0]
+    values = _numbers(node, attrib, kind, {"quat": 4, "axisangle": 4, "euler": 3, "xyaxes": 6, "zaxis": 3}[kind])
+    try:
+        return orientation(kind, values, reader.compiler.degrees, reader.compiler.eulerseq)
+    except ValueError as error:
+        raise node.error(str(error)) from None
+
+
+def _check_known(reader: _Reader, node: Node, attrib: dict[str, str], used: set[str]) -> None:
+    for name in attrib:
+        if name not in used and name not in _COSMETIC:
+            reader.note(node, name, "not supported by tumble; ignored")
+
+
+# --- compiler, option, defaults ------------------------------------------------------------------------
+
+
+def _read_compiler(reader: _Reader, node: Node) -> None:
+    a, c = node.attrib, reader.compiler
+    c.degrees = _keyword(node, a, "angle", "degree" if c.degrees else "radian", ("degree", "radian")) == "degree"
+    c.eulerseq = a.get("eulerseq", c.eulerseq)
+    if len(c.eulerseq) != 3 or any(axis not in "xyzXYZ" for axis in c.eulerseq):
+        raise node.error(f"eulerseq={c.eulerseq!r} must be three of x, y, z, X, Y, Z")
+    c.inertiafromgeom = _flag(node, a, "inertiafromgeom", c.inertiafromgeom)
+    c.boundmass = _number(node, a, "boundmass", c.boundmass, nonnegative=True)
+    c.boundinertia = _number(node, a, "boundinertia", c.boundinertia, nonnegative=True)
+    c.autolimits = _keyword(node, a, "autolimits", "true" if c.autolimits else "false", ("true", "false")) == "true"
+    if "inertiagrouprange" in a:
+        low, high = _numbers(node, a, "inertiagrouprange", 2)
+        c.inertiagrouprange = (int(low), int(high))
+    c.settotalmass = _number(node, a, "settotalmass", c.settotalmass)
+    if a.get("coordinate", "local") != "local":
+        raise node.error("coordinate='global' was removed from MJCF (MuJoCo 2.3.3); use local coordinates")
+    for name, value in a.items():
+        if name not in _COMPILER_READ and not (name in _COMPILER_SWITCHES and value == "false"):
+            reader.note(node, name, "not supported by tumble; ignored")
+
+
+def _read_defaults(reader: _Reader, node: Node, parent: str | None) -> None:
+    name = node.attrib.get("class", "main" if parent is None else None)
+    if name is None:
+        raise node.error("a nested <default> needs a class attribute")
+    if name in reader.defaults and parent is not None:
+        raise node.error(f"default class {name!r} is defined twice")
+    inherited = reader.defaults.get(parent, {}) if parent is not None else {}
+    classes = {tag: dict(attrib) for tag, attrib in inherited.items()}
+    for child in node.children:
+        if child.tag == "default":
+            continue
+        classes.setdefault(child.tag, {}).update(child.attrib)
+    reader.defaults[name] = classes
+    for child in node.children:
+        if child.tag == "default":
+            _read_defaults(reader, child, name)
+
+
+def _resolved(reader: _Reader, node: Node, childclass: str) -> dict[str, str]:
+    """The element's attributes over its class's defaults."""
+    name = node.attrib.get("class", childclass)
+    if name not in reader.defaults:
+        raise node.error(f"class={name!r} names no default class")
+    return {**reader.defaults[name].get(node.tag, {}), **node.attrib}
+
+
+# --- bodies, joints, geoms ---------------------------------------------------------------------------
+
+
+def _joint(reader: _Reader, node: Node, childclass: str, is_top: bool) -> JointDescription:
+    if node.tag == "freejoint":
+        a = {"type": "free", **{k: v for k, v in node.attrib.items() if k in ("name", "group")}}
+        _check_known(reader, node, node.attrib, {"align"})
+    else:
+        a = _resolved(reader, node, childclass)
+        _check_known(reader, node, a, _JOINT)
+    kind = _keyword(node, a, "type", "hinge", _JOINT_TYPES)
+    if kind == "free" and not is_top:
+        raise node.error("a free joint can only be in a top-level body (a child of <worldbody>)")
+    axis = _numbers(node, a, "axis", 3, [0.0, 0.0, 1.0])
+    if kind in ("hinge", "slide"):
+        if np.linalg.norm(axis) < 1e-14:
+            raise node.error(f"axis={a['axis']!r} is zero")
+        axis = axis / np.linalg.norm(axis)
+    angular = kind in ("hinge", "ball") and reader.compiler.degrees
+    scale = np.pi / 180.0 if angular else 1.0
+    limited = _flag(node, a, "limited", "auto")
+    has_range = "range" in a
+    if limited == "auto" and not reader.compiler.autolimits and has_range:
+        raise node.error("range without limited=... needs compiler autolimits='true'")
+    is_limited = limited == "true" or (limited == "auto" and has_range)
+    bounds = None
+    if is_limited and kind != "free":
+        low, high = _numbers(node, a, "range", 2, [0.0, 0.0]) * scale
+        if kind != "ball" and low >= high:
+            raise node.error(f"range={a.get('range')!r} must have its lower bound below the upper")
+        bounds = (float(low), float(high))
+        reader.note(node, "range", "joint limits are not enforced by tumble's Articulation (yet); ignored")
+    ref_scale = np.pi / 180.0 if kind == "hinge" and reader.compiler.degrees else 1.0
+    joint = JointDescription(
+        name=a.get("name"),
+        type=kind,
+        pos=_numbers(node, a, "pos", 3, [0.0, 0.0, 0.0]) if kind != "free" else np.zeros(3),
+        axis=axis,
+        range=bounds,
+        ref=_number(node, a, "ref", 0.0) * ref_scale,
+        springref=_number(node, a, "springref", 0.0) * ref_scale,
+        stiffness=float(_numbers(node, a, "stiffness", (1, 2, 3), [0.0])[0]),
+        damping=_number(node, a, "damping", 0.0, nonnegative=True),
+        armature=_number(node, a, "armature", 0.0, nonnegative=True),
+        frictionloss=_number(node, a, "frictionloss", 0.0, nonnegative=True),
+        line=node.line,
+    )
+    if np.any(_numbers(node, a, "stiffness", (1, 2, 3), [0.0]) != 0.0):
+        reader.note(node, "stiffness", "not simulated by tumble's Articulation (yet); ignored")
+    for name in ("armature", "frictionloss"):
+        if getattr(joint, name) != 0.0:
+            reader.note(node, name, "not simulated by tumble's Articulation (yet); ignored")
+    if kind == "free" and "pos" in a and np.any(_numbers(node, a, "pos", 3)):
+        reader.note(node, "pos", "ignored on a free joint: its coordinates are the body's pose")
+    return joint
+
+
+def _geom(reader: _Reader, node: Node, childclass: str) -> tuple[GeomDescription, MassProperties | None]:
+    """The geom and its mass properties in the body frame (``None``: no mass, or excluded by the group range)."""
+    a = _resolved(reader, node, childclass)
+    _check_known(reader, node, a, _GEOM)
+    kind = _keyword(node, a, "type", "sphere", _GEOM_TYPES)
+    size = np.zeros(3)
+    given = _numbers(node, a, "size", (1, 2, 3), [0.0])
+    size[: given.size] = given
+    pos = _numbers(node, a, "pos", 3, [0.0, 0.0, 0.0])
+    quat = _frame_quat(reader, node, a)
+    if "fromto" in a:
+        if kind not in ("capsule", "cylinder", "box", "ellipsoid"):
+            raise node.error(f"fromto places a capsule, cylinder, box or ellipsoid, not a {kind}")
+        ends = _numbers(node, a, "fromto", 6)
+        segment = ends[3:] - ends[:3]
+        length = float(np.linalg.norm(segment))
+        if length < 1e-14:
+            raise node.error(f"fromto={a['fromto']!r} has zero length")
+        pos, quat = 0.5 * (ends[:3] + ends[3:]), quat_z_to(segment)
+        size[1 if kind in ("capsule", "cylinder") else 2] = 0.5 * length
+    group = int(_number(node, a, "group", 0.0))
+    geom = GeomDescription(
+        name=a.get("name"), type=kind, size=size, pos=pos, quat=quat, group=group,
+        contype=int(_number(node, a, "contype", 1.0)), conaffinity=int(_number(node, a, "conaffinity", 1.0)),
+        friction=_numbers(node, a, "friction", (1, 2, 3), [1.0, 0.005, 0.0001]), line=node.line,
+    )  # fmt: skip
+    low, high = reader.compiler.inertiagrouprange
+    if not low <= group <= high:
+        return geom, None
+    if kind not in VOLUME_TYPES:
+        if kind != "plane":
+            reader.note(node, f"type={kind!r}", "its mass is not computed by tumble (yet); the geom adds none")
+        return geom, None
+    needed = {"sphere": 1, "capsule": 2, "cylinder": 2, "ellipsoid": 3, "box": 3}[kind]
+    if np.any(size[:needed] <= 0.0):
+        raise node.error(f"size={a.get('size')!r}: a {kind} needs {needed} positive sizes")
+    if a.get("shellinertia", "false") == "true":
+        reader.note(node, "shellinertia", "not supported by tumble; the geom's mass is that of a solid")
+    volume = geom_volume(kind, size)
+    if "mass" in a:
+        mass = _number(node, a, "mass", 0.0, nonnegative=True)
+    else:
+        mass = _number(node, a, "density", 1000.0, nonnegative=True) * volume
+    if mass == 0.0:
+        return geom, None
+    return geom, geom_mass_properties(kind, size, mass).transformed(rotation=quat, translation=pos)
+
+
+def _inertial(reader: _Reader, node: Node) -> MassProperties:
+    a = node.attrib
+    _check_known(reader, node, a, _INERTIAL)
+    if "mass" not in a:
+        raise node.error("inertial needs a mass")
+    mass = _number(node, a, "mass", 0.0)
+    if mass <= 0.0:
+        raise node.error(f"mass={a['mass']!r} must be > 0")
+    pos = _numbers(node, a, "pos", 3)
+    if pos is None:
+        raise node.error("inertial needs a pos")
+    if "diaginertia" in a and "fullinertia" in a:
+        raise node.error("give diaginertia or fullinertia, not both")
+    if "fullinertia" in a:
+        if any(kind in a for kind in ORIENTATIONS):
+            raise node.error("fullinertia is in the body frame: it takes no orientation")
+        xx, yy, zz, xy, xz, yz = _numbers(node, a, "fullinertia", 6)
+        tensor = np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]])
+    elif "diaginertia" in a:
+        rotation = quat_to_matrix(_frame_quat(reader, node, a))
+        tensor = rotation @ np.diag(_numbers(node, a, "diaginertia", 3)) @ rotation.T
+    else:
+        raise node.error("inertial needs diaginertia or fullinertia")
+    try:
+        return MassProperties(mass, pos, tensor)
+    except ValueError as error:
+        raise node.error(f"non-physical inertia: {error}") from None
+
+
+def _body(reader: _Reader, node: Node, parent: int, childclass: str, out: list[BodyDescription]) -> None:
+    a = node.attrib
+    _check_known(reader, node, a, _BODY)
+    childclass = a.get("childclass", childclass)
+    if childclass not in reader.defaults:
+        raise node.error(f"childclass={childclass!r} names no default class")
+    joints, geoms, parts, inertial, children = [], [], [], None, []
+    for child in node.children:
+        if child.tag in ("joint", "freejoint"):
+            joints.append(_joint(reader, child, childclass, parent < 0))
+        elif child.tag == "geom":
+            geom, properties = _geom(reader, child, childclass)
+            geoms.append(geom)
+            parts += [properties] if properties is not None else []
+        elif child.tag == "inertial":
+            if inertial is not None:
+                raise child.error("a body has at most one inertial")
+            inertial = _inertial(reader, child)
+        elif child.tag == "body":
+            children.append(child)
+        elif child.tag not in _SILENT:
+            reader.note(child, "element", "not supported by tumble; ignored")
+    if any(j.type == "free" for j in joints) and len(joints) > 1:
+        raise node.error("a body with a free joint can have no other joint")
+    use_geoms = reader.compiler.inertiafromgeom == "true" or (
+        reader.compiler.inertiafromgeom == "auto" and inertial is None
+    )
+    properties = (sum(parts) if parts else None) if use_geoms else inertial
+    properties = bounded(properties, reader.compiler.boundmass, reader.compiler.boundinertia)
+    out.append(BodyDescription(
+        name=a.get("name"), parent=parent, pos=_numbers(node, a, "pos", 3, [0.0, 0.0, 0.0]),
+        quat=_frame_quat(reader, node, a), mass_properties=properties, joints=tuple(joints), geoms=tuple(geoms),
+        line=node.line,
+    ))  # fmt: skip
+    index = len(out) - 1
+    for child in children:
+        _body(reader, child, index, childclass, out)
+
+
+def _read_option_extras(reader: _Reader, node: Node) -> None:
+    """Warn about what in ``<option>`` changes the dynamics but is not simulated: a medium (density, viscosity,
+    wind) and the ``<flag>`` switches; the solver's settings concern contacts and constraints only."""
+    for name in ("density", "viscosity"):
+        if _number(node, node.attrib, name, 0.0) != 0.0:
+            reader.note(node, name, "the medium's forces are not simulated by tumble; ignored")
+    if np.any(_numbers(node, node.attrib, "wind", 3, [0.0, 0.0, 0.0]) != 0.0):
+        reader.note(node, "wind", "the medium's forces are not simulated by tumble; ignored")
+    for child in node.children:
+        reader.note(child, "element", "not supported by tumble; ignored")
+
+
+def _scaled_to_total(bodies: list[BodyDescription], total: float) -> list[BodyDescription]:
+    """``compiler settotalmass``: every body's mass and inertia scaled by one factor so that the masses sum to
+    ``total``."""
+    mass = sum(b.mass_properties.mass for b in bodies if b.mass_properties is not None)
+    if mass <= 0.0:
+        return bodies
+    return [b if b.mass_properties is None else replace(b, mass_properties=b.mass_properties.scaled_to(
+        b.mass_properties.mass * total / mass)) for b in bodies]  # fmt: skip
+
+
+def describe(root: Node, base: Path) -> ModelDescription:
+    """The description of a ``<mujoco>`` tree (``include`` already expanded); warnings for what is not simulated."""
+    reader = _Reader()
+    for node in root.children:  # compiler settings and classes first: MuJoCo reads them before the bodies
+        if node.tag == "compiler":
+            _read_compiler(reader, node)
+    for node in root.children:
+        if node.tag == "default":
+            _read_defaults(reader, node, None)
+    gravity, timestep, integrator = np.array([0.0, 0.0, -9.81]), 0.002, "Euler"
+    bodies: list[BodyDescription] = []
+    world_geoms: list[GeomDescription] = []
+    for node in root.children:
+        if node.tag == "option":
+            _read_option_extras(reader, node)
+            gravity = _numbers(node, node.attrib, "gravity", 3, gravity)
+            timestep = _number(node, node.attrib, "timestep", timestep)
+            if timestep <= 0:
+                raise node.error(f"timestep={node.attrib['timestep']!r} must be > 0")
+            integrator = _keyword(node, node.attrib, "integrator", integrator,
+                                  ("Euler", "RK4", "implicit", "implicitfast"))  # fmt: skip
+        elif node.tag == "worldbody":
+            for child in node.children:
+                if child.tag == "body":
+                    _body(reader, child, -1, "main", bodies)
+                elif child.tag == "geom":
+                    world_geoms.append(_geom(reader, child, "main")[0])
+                elif child.tag not in _SILENT:
+                    reader.note(child, "element", "not supported by tumble; ignored")
+        elif node.tag not in _SILENT and node.tag not in ("compiler", "default"):
+            reader.note(node, "element", "not loaded into an Articulation; ignored")
+    if reader.compiler.settotalmass > 0:
+        bodies = _scaled_to_total(bodies, reader.compiler.settotalmass)
+    reader.warn_all(root.file)
+    return ModelDescription(
+        name=root.attrib.get("model", "MuJoCo Model"), source=root.file, bodies=tuple(bodies),
+        world_geoms=tuple(world_geoms), gravity=gravity, timestep=timestep, integrator=integrator,
+    )  # fmt: skip

@@ -1,0 +1,102 @@
+"""The XML of an MJCF file as a tree of :class:`Node` that remember their file and line, with ``include`` expanded.
+
+The standard library's ElementTree keeps no line numbers, and every message about a model file must name one, so
+the tree is built here from ``xml.parsers.expat`` events (attributes and children; MJCF has no text content).
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+from xml.parsers import expat
+
+__all__ = ["MJCFError", "Node", "read_model"]
+
+
+class MJCFError(ValueError):
+    """A model file that cannot be loaded; the message names the file, the element and its line."""
+
+
+@dataclass(eq=False)
+class Node:
+    """One XML element: its tag, attributes, children, and where it was written."""
+
+    tag: str
+    attrib: dict[str, str]
+    file: str
+    line: int
+    children: list[Node] = field(default_factory=list)
+
+    def where(self) -> str:
+        return f"{self.file}, line {self.line}, <{self.tag}>"
+
+    def error(self, message: str) -> MJCFError:
+        return MJCFError(f"{self.where()}: {message}")
+
+
+def _parse(text: str | bytes, source: str) -> Node:
+    parser = expat.ParserCreate()
+    stack: list[Node] = []
+    roots: list[Node] = []
+
+    def start(tag, attrib):
+        node = Node(tag, dict(attrib), source, parser.CurrentLineNumber)
+        (stack[-1].children if stack else roots).append(node)
+        stack.append(node)
+
+    parser.StartElementHandler = start
+    parser.EndElementHandler = lambda tag: stack.pop()
+    try:
+        parser.Parse(text, True)
+    except expat.ExpatError as error:
+        raise MJCFError(f"{source}, line {error.lineno}: malformed XML ({expat.ErrorString(error.code)})") from None
+    root = roots[0]
+    if root.tag != "mujoco":
+        raise root.error("the root element must be <mujoco>")
+    return root
+
+
+def read_model(path_or_xml: str | os.PathLike) -> tuple[Node, Path]:
+    """The ``<mujoco>`` tree of a file (a path) or of XML text (a string starting with ``<``), ``include`` expanded,
+    and the directory that relative paths start from (the file's, or the working directory for text)."""
+    if isinstance(path_or_xml, str) and path_or_xml.lstrip().startswith("<"):
+        base, chain = Path.cwd().resolve(), ["<string>"]
+        root = _parse(path_or_xml, "<string>")
+    else:
+        path = Path(path_or_xml)
+        if not path.is_file():
+            raise MJCFError(f"{path}: no such model file")
+        base, chain = path.resolve().parent, [str(path.resolve())]
+        root = _parse(path.read_bytes(), str(path))
+    _expand_includes(root, base, base, chain)
+    return root, base
+
+
+def _expand_includes(node: Node, model_dir: Path, here: Path, chain: list[str]) -> None:
+    """Replace each ``<include file=...>`` by the children of the included file's ``<mujoco>`` (a path relative to
+    the main file's directory, else to the including file's, as MuJoCo finds it), refusing loops and paths that
+    leave the model's directory."""
+    expanded: list[Node] = []
+    for child in node.children:
+        if child.tag != "include":
+            _expand_includes(child, model_dir, here, chain)
+            expanded.append(child)
+            continue
+        name = child.attrib.get("file")
+        if not name:
+            raise child.error("include needs a file attribute")
+        # MuJoCo looks beside the main file first, then beside the including file (measured with MuJoCo 4).
+        target = (model_dir / name).resolve()
+        if not target.is_file():
+            target = (here / name).resolve()
+        if not target.is_relative_to(model_dir):
+            raise child.error(f"include file={name!r} leaves the model's directory {model_dir}")
+        if str(target) in chain:
+            raise child.error(f"include file={name!r} includes itself (through {' -> '.join(chain)})")
+        if not target.is_file():
+            raise child.error(f"include file={name!r}: no such file ({target})")
+        included = _parse(target.read_bytes(), str(target))
+        _expand_includes(included, model_dir, target.parent, [*chain, str(target)])
+        expanded.extend(included.children)
+    node.children = expanded

@@ -1,0 +1,172 @@
+"""MJCF files nobody here wrote, loaded by tumble and by MuJoCo: the compiled models and their dynamics compared.
+
+MuJoCo is the oracle for what a file means. Gymnasium's MuJoCo assets (ant, half_cheetah, hopper, humanoid, …) and
+models written here to exercise the rest of the format (default classes, childclass, every orientation, fromto,
+refs, several joints in a body, ``inertial`` and geoms) are read by :func:`tumble.articulation.from_mjcf` and by
+``mujoco.MjModel``; bodies, masses, inertias, joint frames, mass matrices and accelerations must agree to round-off.
+What tumble's articulation does not simulate yet (armature, joint springs and friction, a viscous medium, limits)
+is switched off on MuJoCo's side through ``MjSpec`` and reported by tumble's warnings.
+"""
+
+from __future__ import annotations
+
+import os
+import warnings
+
+import numpy as np
+import pytest
+
+from tumble.articulation import from_mjcf
+from tumble.models.mjcf import MJCFWarning, read_mjcf
+from tumble.rotation import quat_to_matrix
+
+mujoco = pytest.importorskip("mujoco")
+gymnasium = pytest.importorskip("gymnasium")
+pytestmark = pytest.mark.peers
+
+ASSETS = os.path.join(os.path.dirname(gymnasium.__file__), "envs", "mujoco", "assets")
+GYMNASIUM = sorted(name for name in os.listdir(ASSETS) if name.endswith(".xml"))
+
+EXERCISE = """<mujoco model="exercise">
+  <compiler angle="degree" eulerseq="zyX" autolimits="true"/>
+  <option timestep="0.004" gravity="0.3 -0.2 -9.7"/>
+  <default>
+    <joint damping="0.2"/>
+    <geom density="700"/>
+    <default class="limb">
+      <geom type="capsule" size="0.04"/>
+      <joint axis="0 1 0"/>
+      <default class="heavy"><geom density="2500"/></default>
+    </default>
+  </default>
+  <worldbody>
+    <geom type="plane" size="3 3 0.1"/>
+    <body name="torso" pos="0.1 -0.2 1.2" euler="10 -20 30">
+      <freejoint name="root"/>
+      <geom type="box" size="0.2 0.12 0.06"/>
+      <geom type="ellipsoid" size="0.05 0.08 0.03" pos="0 0 0.1" axisangle="1 1 0 40"/>
+      <body name="thigh" pos="0.2 0 0" childclass="limb" xyaxes="0 1 0 -1 0.2 0">
+        <joint name="hip_y" pos="0.01 0 0" ref="15" range="-60 60"/>
+        <joint name="hip_x" axis="1 0 0" pos="0.02 0.01 0"/>
+        <geom fromto="0 0 0 0.3 0 -0.2"/>
+        <body name="shin" pos="0.3 0 -0.2" zaxis="0.2 0.1 1">
+          <joint name="knee" type="slide" axis="0 0 1" ref="0.05" damping="1.5"/>
+          <geom class="heavy" type="cylinder" fromto="0 0 0 0 0 -0.3" size="0.03"/>
+          <body name="foot" pos="0 0.1 -0.3" quat="0.9 0.1 -0.2 0.3">
+            <joint type="ball" pos="0 0 0.02"/>
+            <inertial pos="0.01 0.02 0.03" mass="0.3" diaginertia="0.01 0.02 0.025" euler="30 20 10"/>
+          </body>
+        </body>
+      </body>
+      <body name="tail" pos="-0.25 0 0">
+        <inertial pos="-0.05 0 0" mass="0.4" fullinertia="0.003 0.004 0.005 0.0005 -0.0002 0.0001"/>
+        <body name="tip" pos="-0.1 0 0.05"><joint type="hinge" axis="0 0 1"/><geom type="sphere" size="0.05"/></body>
+      </body>
+    </body>
+  </worldbody>
+</mujoco>"""
+
+
+def _source(name: str) -> str:
+    return EXERCISE if name == "exercise" else os.path.join(ASSETS, name)
+
+
+def _load(name: str):
+    """tumble's articulation and description, and MuJoCo's model with what tumble does not simulate switched off."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", MJCFWarning)
+        art, description = from_mjcf(_source(name)), read_mjcf(_source(name))
+    spec = mujoco.MjSpec.from_string(EXERCISE) if name == "exercise" else mujoco.MjSpec.from_file(_source(name))
+    for joint in spec.joints:
+        joint.armature, joint.frictionloss = 0.0, 0.0
+        try:
+            joint.stiffness = np.zeros(3)  # MuJoCo 4: a polynomial spring
+        except TypeError:
+            joint.stiffness = 0.0
+    spec.option.viscosity = spec.option.density = 0.0
+    spec.option.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONSTRAINT  # no contacts, limits or tendons' loads
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # half_cheetah's deprecated settotalmass
+        model = spec.compile()
+    return art, description, model
+
+
+MODELS = ["exercise", *GYMNASIUM]
+
+
+@pytest.mark.parametrize("name", MODELS)
+def test_bodies_masses_inertias_and_joints_equal_mujocos_compiled_model(name):
+    _, description, model = _load(name)
+    assert len(description.bodies) == model.nbody - 1
+    for index, body in enumerate(description.bodies, start=1):
+        assert body.name == (model.body(index).name or None)
+        assert body.parent + 1 == model.body_parentid[index]
+        np.testing.assert_allclose(body.pos, model.body_pos[index], rtol=0, atol=1e-12)
+        assert abs(abs(np.dot(body.quat, model.body_quat[index])) - 1.0) < 1e-12
+        mp = body.mass_properties
+        assert (mp.mass if mp is not None else 0.0) == pytest.approx(model.body_mass[index], rel=1e-12, abs=1e-15)
+        if mp is not None:
+            np.testing.assert_allclose(mp.com, model.body_ipos[index], rtol=0, atol=1e-12)
+            rotation = quat_to_matrix(model.body_iquat[index])
+            tensor = rotation @ np.diag(model.body_inertia[index]) @ rotation.T
+            np.testing.assert_allclose(mp.inertia, tensor, rtol=0, atol=1e-9 * max(np.abs(tensor).max(), 1e-12))
+        first = model.body_jntadr[index]
+        assert len(body.joints) == model.body_jntnum[index]
+        for k, joint in enumerate(body.joints):
+            j = first + k
+            assert joint.type == ("free", "ball", "slide", "hinge")[model.jnt_type[j]]
+            if joint.type in ("hinge", "slide"):
+                np.testing.assert_allclose(joint.axis, model.jnt_axis[j], rtol=0, atol=1e-12)
+                np.testing.assert_allclose(joint.pos, model.jnt_pos[j], rtol=0, atol=1e-12)
+                assert joint.damping == model.dof_damping[model.jnt_dofadr[j]]
+
+
+def _random_state(model, rng):
+    q = model.qpos0 + 0.4 * rng.normal(size=model.nq)
+    for j in range(model.njnt):
+        if model.jnt_type[j] in (mujoco.mjtJoint.mjJNT_FREE, mujoco.mjtJoint.mjJNT_BALL):
+            start = model.jnt_qposadr[j] + (3 if model.jnt_type[j] == mujoco.mjtJoint.mjJNT_FREE else 0)
+            q[start : start + 4] /= np.linalg.norm(q[start : start + 4])
+    return q, rng.normal(size=model.nv)
+
+
+@pytest.mark.parametrize("name", MODELS)
+def test_link_frames_mass_matrix_and_accelerations_equal_mujocos(name):
+    art, description, model = _load(name)
+    data = mujoco.MjData(model)
+    assert (art.nq, art.nv) == (model.nq, model.nv)
+    np.testing.assert_allclose(art.q, model.qpos0, rtol=0, atol=1e-15)  # it starts at qpos0, refs included
+    rng = np.random.default_rng(25)
+    for _ in range(3):
+        q, qd = _random_state(model, rng)
+        data.qpos[:], data.qvel[:] = q, qd
+        mujoco.mj_forward(model, data)
+        # A body's last link is the body frame moved to its last joint's pos (a welded body's: the body frame).
+        positions, quats = art.link_poses(q)
+        for index, body in enumerate(description.bodies, start=1):
+            if body.name is None:
+                continue
+            link = art.link_index(body.name)
+            anchor = body.joints[-1].pos if body.joints else np.zeros(3)
+            expected = data.xpos[index] + data.xmat[index].reshape(3, 3) @ anchor
+            np.testing.assert_allclose(positions[link], expected, rtol=0, atol=1e-12)
+            assert abs(abs(np.dot(quats[link], data.xquat[index])) - 1.0) < 1e-12
+        full = np.zeros((model.nv, model.nv))
+        mujoco.mj_fullM(model, data, full)
+        scale = np.abs(full).max()
+        np.testing.assert_allclose(art.mass_matrix(q), full, rtol=0, atol=1e-12 * scale)  # measured < 1e-15 relative
+        np.testing.assert_allclose(art.bias_forces(q, qd), data.qfrc_bias - data.qfrc_passive, rtol=0,
+                                   atol=1e-10 * max(1.0, np.abs(data.qfrc_bias).max()))  # fmt: skip
+        acc = art.forward_dynamics(q, qd)
+        np.testing.assert_allclose(acc, data.qacc, rtol=0, atol=1e-9 * max(1.0, np.abs(data.qacc).max()))
+
+
+def test_the_warnings_name_what_is_not_simulated_once_each_with_its_line():
+    with pytest.warns(MJCFWarning) as record:
+        from_mjcf(os.path.join(ASSETS, "humanoid.xml"))
+    messages = [str(w.message) for w in record]
+    assert len(messages) == len(set(messages))
+    assert any("<joint> armature (line " in m and "more)" in m for m in messages)
+    assert any("<tendon> element (line " in m for m in messages)
+    assert any("<actuator> element (line " in m for m in messages)
+    assert all("humanoid.xml" in m for m in messages)

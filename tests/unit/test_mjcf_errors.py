@@ -1,0 +1,133 @@
+"""MJCF files that cannot be loaded give one error naming the file, the element and its line; what tumble reads but
+does not simulate gives one warning per element and attribute. The reader's rules for defaults, orientations and
+includes are checked here without MuJoCo (tests/peers/test_mjcf_models.py compares with MuJoCo's compiled models).
+"""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+import pytest
+
+from tumble.articulation import from_mjcf
+from tumble.models.mjcf import MJCFError, MJCFWarning, read_mjcf
+from tumble.rotation import quat_from_axis_angle, quat_multiply
+
+
+def model(body: str, head: str = "") -> str:
+    return f"<mujoco>{head}<worldbody>{body}</worldbody></mujoco>"
+
+
+def quiet(text):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", MJCFWarning)
+        return read_mjcf(text)
+
+
+@pytest.mark.parametrize(
+    ("text", "match"),
+    [
+        ("<mujoco><worldbody><body></worldbody></mujoco>", r"<string>, line 1: malformed XML \(mismatched tag\)"),
+        ("<robot/>", r"<string>, line 1, <robot>: the root element must be <mujoco>"),
+        (model('<body>\n<joint type="screw"/><geom size="1"/></body>'), r"line 2, <joint>: type='screw' must be one "
+         "of hinge, slide, ball, free"),
+        (model('<body><inertial pos="0 0 0" mass="1" diaginertia="1 1 3"/></body>'), r"line 1, <inertial>: "
+         "non-physical inertia: .*triangle inequality"),
+        (model('<body><inertial pos="0 0 0" mass="0" diaginertia="1 1 1"/></body>'), r"<inertial>: mass='0' must "
+         "be > 0"),
+        (model('<body><geom size="1 2 3 4"/></body>'), r"<geom>: size='1 2 3 4' must be 1 or 2 or 3 finite numbers"),
+        (model('<body pos="0 nan 0"><geom size="1"/></body>'), r"<body>: pos='0 nan 0' must be 3 finite numbers"),
+        (model('<body quat="1 0 0 0" euler="0 0 1"><geom size="1"/></body>'), r"give at most one orientation, got "
+         "quat, euler"),
+        (model('<body><geom class="nope" size="1"/></body>'), r"<geom>: class='nope' names no default class"),
+        (model('<body><body><freejoint/><geom size="1"/></body></body>'), r"<freejoint>: a free joint can only be "
+         "in a top-level body"),
+        (model('<body><geom type="box" size="1 0 1"/></body>'), r"<geom>: size='1 0 1': a box needs 3 positive"),
+        (model('<body><joint axis="0 0 0"/><geom size="1"/></body>'), r"<joint>: axis='0 0 0' is zero"),
+        (model('<body><geom type="capsule" fromto="0 0 0 0 0 0" size="1"/></body>'), r"fromto=.* has zero length"),
+        (model("", '<compiler coordinate="global"/>'), r"coordinate='global' was removed"),
+        (model('<include file="missing.xml"/>'), r"<include>: include file='missing.xml': no such file"),
+        (model('<include file="../outside.xml"/>'), r"include file='../outside.xml' leaves the model's directory"),
+    ],
+)  # fmt: skip
+def test_a_bad_file_gives_one_error_naming_the_element_and_line(text, match):
+    with pytest.raises(MJCFError, match=match):
+        quiet(text)
+
+
+def test_a_missing_file_and_an_include_loop_name_the_files(tmp_path):
+    with pytest.raises(MJCFError, match=r"no_such\.xml: no such model file"):
+        read_mjcf(tmp_path / "no_such.xml")
+    (tmp_path / "a.xml").write_text('<mujoco><include file="b.xml"/></mujoco>')
+    (tmp_path / "b.xml").write_text('<mujoco>\n\n<include file="a.xml"/></mujoco>')
+    with pytest.raises(MJCFError, match=r"b\.xml, line 3, <include>: include file='a\.xml' includes itself"):
+        read_mjcf(tmp_path / "a.xml")
+
+
+def test_includes_are_found_beside_the_main_file_first_then_beside_the_including_file(tmp_path):
+    (tmp_path / "sub").mkdir()
+    (tmp_path / "main.xml").write_text('<mujoco><worldbody><include file="sub/arm.xml"/></worldbody></mujoco>')
+    (tmp_path / "sub" / "arm.xml").write_text('<mujoco><body name="arm"><geom size="0.1"/>'
+                                              '<include file="hand.xml"/></body></mujoco>')  # fmt: skip
+    (tmp_path / "sub" / "hand.xml").write_text('<mujoco><body name="hand_in_sub"><geom size="0.1"/></body></mujoco>')
+    assert [b.name for b in read_mjcf(tmp_path / "main.xml").bodies] == ["arm", "hand_in_sub"]
+    (tmp_path / "hand.xml").write_text('<mujoco><body name="hand_in_main"><geom size="0.1"/></body></mujoco>')
+    assert [b.name for b in read_mjcf(tmp_path / "main.xml").bodies] == ["arm", "hand_in_main"]
+
+
+def test_each_unsupported_element_and_attribute_warns_once_with_its_first_line_and_count():
+    text = model(
+        '<body>\n<joint frictionloss="1" damping="0.1"/>\n<joint frictionloss="2" bogus="3"/><geom size="1"/></body>',
+        "<tendon/><actuator/>",
+    )
+    with pytest.warns(MJCFWarning) as record:
+        from_mjcf(text)
+    messages = sorted(str(w.message) for w in record)
+    assert messages == [
+        "<string>: <actuator> element (line 1): not loaded into an Articulation; ignored",
+        "<string>: <joint> bogus (line 3): not supported by tumble; ignored",
+        "<string>: <joint> frictionloss (line 2 and 1 more): not simulated by tumble's Articulation (yet); ignored",
+        "<string>: <tendon> element (line 1): not loaded into an Articulation; ignored",
+    ]
+
+
+def test_a_supported_file_loads_without_a_warning():
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        art = from_mjcf(model('<body name="a"><joint/><geom size="0.1" rgba="1 0 0 1"/><site/></body>'))
+    assert art.links[0].name == "a"
+
+
+def test_defaults_nest_and_childclass_reaches_nested_bodies():
+    head = ('<default><geom density="10"/><default class="a"><geom type="box" size="1 1 1"/>'
+            '<default class="b"><geom density="20"/></default></default></default>')  # fmt: skip
+    body = ('<body name="p" childclass="a"><geom/><body name="c"><geom class="b"/><geom class="main" size="1"/>'
+            "</body></body>")  # fmt: skip
+    bodies = quiet(model(body, head)).bodies
+    assert bodies[0].mass_properties.mass == pytest.approx(10 * 8.0)  # class a: a 2 m box at main's density
+    sphere = 4.0 / 3.0 * np.pi
+    assert bodies[1].mass_properties.mass == pytest.approx(20 * 8.0 + 10 * sphere)  # b's box, main's sphere
+
+
+@pytest.mark.parametrize(
+    ("attribute", "expected"),
+    [
+        ('euler="90 0 0"', quat_from_axis_angle((1, 0, 0), np.pi / 2)),
+        ('axisangle="0 0 2 90"', quat_from_axis_angle((0, 0, 1), np.pi / 2)),
+        ('xyaxes="0 1 0 -1 0 0"', quat_from_axis_angle((0, 0, 1), np.pi / 2)),
+        ('zaxis="1 0 0"', quat_from_axis_angle((0, 1, 0), np.pi / 2)),
+        ('quat="2 0 0 0"', np.array([1.0, 0.0, 0.0, 0.0])),
+    ],
+)
+def test_orientations_in_degrees(attribute, expected):
+    body = quiet(model(f'<body {attribute}><geom size="1"/></body>')).bodies[0]
+    np.testing.assert_allclose(body.quat, expected, atol=1e-15)
+
+
+def test_euler_sequences_turn_with_the_frame_in_lowercase_and_about_fixed_axes_in_uppercase():
+    head = '<compiler angle="radian" eulerseq="{}"/>'
+    x, z = quat_from_axis_angle((1, 0, 0), 0.3), quat_from_axis_angle((0, 0, 1), 0.5)
+    for seq, expected in (("xyz", quat_multiply(x, z)), ("XYZ", quat_multiply(z, x))):
+        body = quiet(model('<body euler="0.3 0 0.5"><geom size="1"/></body>', head.format(seq))).bodies[0]
+        np.testing.assert_allclose(body.quat, expected, atol=1e-15)
