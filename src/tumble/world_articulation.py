@@ -32,6 +32,10 @@ def _check(art) -> None:
         label = link.name or link.index
         if link.mass_properties is None or not link.mass_properties.mass > 0.0:
             raise ValueError(f"link {label!r} has no mass: every link of an articulation in a world becomes a body")
+        for name in ("armature", "stiffness"):
+            if getattr(link, name) != 0.0:
+                raise ValueError(f"link {label!r} has joint {name} {getattr(link, name)!r}: world joints have none; "
+                                 "step the articulation on its own")  # fmt: skip
         if link.damping != 0.0:
             raise ValueError(
                 f"link {label!r} has joint damping {link.damping!r}: world joints have none; step the articulation "

@@ -5,7 +5,8 @@ bias force ``p^A`` (the subtree as it feels to a force applied at the link, join
 outwards gives the accelerations. In world coordinates at the world origin, as everywhere here, the
 coordinate transforms of the textbook are identities. Per degree of freedom, with ``S`` its motion column:
 
-    U = I^A S,  D = Sᵀ U,  u = τ - d q̇ - Sᵀ p^A            (d: joint damping)
+    U = I^A S,  D = Sᵀ U + a,  u = τ - d q̇ - k (q - q_r) - Sᵀ p^A
+                                        (a: armature, d: damping, k, q_r: the joint's spring)
     I^A ← I^A - U Uᵀ / D,   p^A ← p^A + U u / D            then, for the parent:
     I^A_λ += I^A,   p^A_λ += p^A + I^A c                    (c: the joint's velocity product)
     a' = a_λ + c,   q̈ = (u - Uᵀ a') / D,   a ← a' + S q̈    (outwards; a_base = -g)
@@ -21,8 +22,21 @@ from __future__ import annotations
 
 from .._jit import inline
 from ..math3d import add, scale
-from .dynamics import SINGULAR_RTOL
-from .model import ACC, ART_BIAS, ART_INERTIA, ART_STORED, GRAVITY, INERTIA_WORLD, PARENT, V_START, VEL, VEL_PRODUCT
+from .dynamics import SINGULAR_RTOL, passive_force
+from .model import (
+    ACC,
+    ARMATURE,
+    ART_BIAS,
+    ART_INERTIA,
+    ART_STORED,
+    GRAVITY,
+    INERTIA_WORLD,
+    PARENT,
+    Q_START,
+    V_START,
+    VEL,
+    VEL_PRODUCT,
+)
 from .spatial import ZERO3, ZERO6, add6, cross_force, dot6, get3, get6, get10, inertia_apply, put6, scale6, sub6, vec3
 
 __all__ = ["aba"]
@@ -103,14 +117,15 @@ def _external_force(external, i, inertia):
 
 
 @inline
-def aba(link_ints, world, dof_damping, link_work, dof_motion, dof_u, dof_pivot, qd, tau, external, use_external, qdd):
+def aba(link_ints, world, dof_params, link_work, dof_motion, dof_u, dof_pivot, q, qd, tau, external, use_external,
+        qdd):  # fmt: skip
     """``q̈`` (nv,) into ``qdd`` for the joint forces ``tau`` (nv,); returns -1 or the row of a singular pivot.
 
     Args:
         link_work: (n, width) after :func:`~.kinematics.forward_kinematics`; uses ``ART_INERTIA``,
             ``ART_BIAS``, ``ART_STORED``, ``ACC``.
         dof_motion: (nv, 6) ``S``; dof_u: (nv, 6) scratch for ``U``; dof_pivot: (nv,) scratch for ``D``.
-        qd: (nv,); external: (n, 6) world-frame rows (force at the link's centre of mass, torque), read if
+        q: (nq,), qd: (nv,); external: (n, 6) world-frame rows (force at the link's centre of mass, torque), read if
             ``use_external``. ``qdd`` holds ``u`` between the two sweeps.
     """
     n, nv = link_ints.shape[0], dof_motion.shape[0]
@@ -140,10 +155,11 @@ def aba(link_ints, world, dof_damping, link_work, dof_motion, dof_u, dof_pivot, 
         for k in range(stop - 1, first - 1, -1):
             s = get6(dof_motion, k, 0)
             u_vec = _apply(inertia, s)
-            pivot = dot6(s, u_vec)
+            pivot = dot6(s, u_vec) + dof_params[k, ARMATURE]
             if not pivot > SINGULAR_RTOL * largest:
                 return k
-            u = tau[k] - dof_damping[k] * qd[k] - dot6(s, bias)
+            spring_q = q[link_ints[i, Q_START] + k - first]
+            u = tau[k] - passive_force(dof_params, k, spring_q, qd[k]) - dot6(s, bias)
             put6(dof_u, k, 0, u_vec)
             dof_pivot[k] = pivot
             qdd[k] = u

@@ -30,7 +30,7 @@ from ..mass import MassProperties
 from ..rotation import quat_from_rotvec, quat_multiply, quat_to_matrix
 from ..shapes import Shape
 from .integrators import EULER, NOT_FINITE, RK4, SYMPLECTIC
-from .joints import Ball, Free, Joint
+from .joints import Ball, Free, Joint, Prismatic, Revolute
 from .kernels import FORWARD, INVERSE, KINEMATICS, MASS_MATRIX, PROJECT, SIMULATE, articulation_kernel
 from .loops import LoopClosure
 from .model import (
@@ -73,6 +73,8 @@ class Link:
         damping: joint damping (torque ``-damping q̇`` on each of its degrees of freedom).
         q_slice, v_slice: the link's rows of ``q`` and ``qd``.
         shape, shape_position, shape_orientation: the geometry, if any, in the link frame.
+        armature: inertia added to each of the joint's degrees of freedom (a motor's rotor, as MuJoCo's).
+        stiffness, springref: a spring ``-stiffness (q - springref)`` on a revolute or prismatic joint.
     """
 
     index: int
@@ -88,6 +90,9 @@ class Link:
     shape: Shape | None = None
     shape_position: np.ndarray = field(default_factory=lambda: _readonly((0.0, 0.0, 0.0)))
     shape_orientation: np.ndarray = field(default_factory=lambda: _readonly((1.0, 0.0, 0.0, 0.0)))
+    armature: float = 0.0
+    stiffness: float = 0.0
+    springref: float = 0.0
 
 
 @dataclass(frozen=True, eq=False)
@@ -168,7 +173,8 @@ class Articulation:
 
     def add_link(self, joint, *, parent=None, position=(0.0, 0.0, 0.0), orientation=(1.0, 0.0, 0.0, 0.0),
                  shape=None, mass=None, density=None, mass_properties=None, shape_position=(0.0, 0.0, 0.0),
-                 shape_orientation=(1.0, 0.0, 0.0, 0.0), damping=0.0, name=None) -> int:  # fmt: skip
+                 shape_orientation=(1.0, 0.0, 0.0, 0.0), damping=0.0, name=None, armature=0.0, stiffness=0.0,
+                 springref=0.0) -> int:  # fmt: skip
         """Add a link joined to ``parent`` by ``joint``; returns its index.
 
         Args:
@@ -185,6 +191,10 @@ class Articulation:
                 the dynamics check.
             damping: >= 0, joint damping: a force ``-damping q̇`` on each of the joint's degrees of freedom.
             name: optional unique label.
+            armature: >= 0, inertia [kg m² or kg] added to each of the joint's degrees of freedom: the reflected
+                inertia of a motor's rotor, on the mass matrix's diagonal (MuJoCo's ``armature``).
+            stiffness: >= 0, springref: a spring ``-stiffness (q - springref)`` on a ``Revolute`` or ``Prismatic``
+                joint; its energy counts in ``potential_energy``.
         """
         if not isinstance(joint, Joint):
             raise TypeError(f"joint must be a Revolute, Prismatic, Ball, Free or Fixed, got {_show(joint)}")
@@ -196,6 +206,11 @@ class Articulation:
         shape_orientation = _readonly(as_quaternion("shape_orientation", shape_orientation))
         properties = _mass_properties(shape, mass, density, mass_properties, shape_position, shape_orientation)
         damping = as_float("damping", damping, nonnegative=True)
+        armature = as_float("armature", armature, nonnegative=True)
+        stiffness = as_float("stiffness", stiffness, nonnegative=True)
+        springref = as_float("springref", springref)
+        if stiffness != 0.0 and not isinstance(joint, (Revolute, Prismatic)):
+            raise ValueError(f"stiffness={stiffness!r} needs a Revolute or Prismatic joint, got {joint!r}")
         if name is not None and not isinstance(name, str):
             raise TypeError(f"name must be a string or None, got {_show(name)}")
         if name is not None and any(link.name == name for link in self._links):
@@ -203,7 +218,7 @@ class Articulation:
         nq, nv = self.nq, self.nv
         link = Link(index, name, parent, joint, position, orientation, properties, damping,
                     slice(nq, nq + joint.nq), slice(nv, nv + joint.nv), shape, shape_position,
-                    shape_orientation)  # fmt: skip
+                    shape_orientation, armature, stiffness, springref)  # fmt: skip
         # the joint's initial coordinates: zero displacement
         initial = np.zeros(joint.nq)
         if isinstance(joint, Ball):

@@ -9,8 +9,10 @@
 * LTDL (§6.5): ``H = Lᵀ D L`` following ``dof_parent``, so branches of the tree cost nothing; forward dynamics
   is ``H q̈ = τ - C(q, q̇)`` solved with it (§6.1; ``integrators.accelerations``).
 
-Joint damping is part of the bias: ``C = RNEA(q, q̇, 0) + D q̇`` with ``D`` the diagonal of ``dof_damping``,
-so inverse dynamics returns the actuator force that produces ``q̈`` against damping too.
+The joints' passive forces are part of the bias: ``C = RNEA(q, q̇, 0) + D q̇ + K (q - q_ref)`` with ``D`` and ``K``
+the diagonals of the damping and stiffness in ``dof_params``, so inverse dynamics returns the actuator force that
+produces ``q̈`` against them too. A joint's armature (the reflected inertia of a motor's rotor, as in MuJoCo) adds
+to ``H``'s diagonal.
 """
 
 from __future__ import annotations
@@ -19,7 +21,9 @@ from .._jit import inline
 from ..math3d import add, cross, scale, sub
 from .model import (
     ACC,
+    ARMATURE,
     COMPOSITE,
+    DAMPING,
     DOF_LINK,
     DOF_PARENT,
     FORCE,
@@ -27,6 +31,9 @@ from .model import (
     INERTIA_WORLD,
     PARENT,
     POS,
+    Q_START,
+    SPRINGREF,
+    STIFFNESS,
     V_START,
     VEL,
     VEL_PRODUCT,
@@ -61,8 +68,35 @@ def _dof_stop(link_ints, i, v_count):
 
 
 @inline
-def rnea(link_ints, world, dof_damping, link_work, dof_motion, qd, qdd, external, use_external, out):
-    """``out = H q̈ + C + D q̇``: the generalised forces (nv,) that give the accelerations ``qdd``.
+def joint_energies(link_ints, dof_params, q, qd):
+    """``(½ Σ armature q̇², ½ Σ stiffness (q - springref)²)``: the kinetic energy of the joints' rotors and the
+    potential energy of their springs, beside the links' own (``kinematics.energies``)."""
+    kinetic, potential = 0.0, 0.0
+    n, nv = link_ints.shape[0], qd.shape[0]
+    for i in range(n):
+        first = link_ints[i, V_START]
+        for k in range(first, _dof_stop(link_ints, i, nv)):
+            kinetic += 0.5 * dof_params[k, ARMATURE] * qd[k] * qd[k]
+            if dof_params[k, STIFFNESS] != 0.0:
+                stretch = q[link_ints[i, Q_START] + k - first] - dof_params[k, SPRINGREF]
+                potential += 0.5 * dof_params[k, STIFFNESS] * stretch * stretch
+    return kinetic, potential
+
+
+@inline
+def passive_force(dof_params, k, q_value, qd_value):
+    """The joint's force against degree of freedom ``k``: ``damping q̇ + stiffness (q - springref)`` (a spring only
+    on a hinge or slide, whose coordinate ``q_value`` is its own; elsewhere the stiffness is zero)."""
+    force = dof_params[k, DAMPING] * qd_value
+    if dof_params[k, STIFFNESS] != 0.0:
+        force += dof_params[k, STIFFNESS] * (q_value - dof_params[k, SPRINGREF])
+    return force
+
+
+@inline
+def rnea(link_ints, world, dof_params, link_work, dof_motion, q, qd, qdd, external, use_external, out):
+    """``out = H q̈ + C + D q̇ + K (q - q_ref)``: the generalised forces (nv,) that give the accelerations ``qdd``
+    (``H`` with the joints' armature on its diagonal; ``D``, ``K``: the joints' damping and springs).
 
     Args:
         link_work: (n, 51) after :func:`~.kinematics.forward_kinematics`; writes ``ACC`` and ``FORCE``.
@@ -90,17 +124,21 @@ def rnea(link_ints, world, dof_damping, link_work, dof_motion, qd, qdd, external
         put6(link_work, i, FORCE, force)
     for i in range(n - 1, -1, -1):
         force = get6(link_work, i, FORCE)
-        for k in range(link_ints[i, V_START], _dof_stop(link_ints, i, nv)):
-            out[k] = dot6(get6(dof_motion, k, 0), force) + dof_damping[k] * qd[k]
+        first = link_ints[i, V_START]
+        for k in range(first, _dof_stop(link_ints, i, nv)):
+            spring_q = q[link_ints[i, Q_START] + k - first]
+            out[k] = (dot6(get6(dof_motion, k, 0), force) + passive_force(dof_params, k, spring_q, qd[k])
+                      + dof_params[k, ARMATURE] * qdd[k])  # fmt: skip
         parent = link_ints[i, PARENT]
         if parent >= 0:
             put6(link_work, parent, FORCE, add6(get6(link_work, parent, FORCE), force))
 
 
 @inline
-def crba(link_ints, dof_ints, link_work, dof_motion, h):
+def crba(link_ints, dof_ints, dof_params, link_work, dof_motion, h):
     """The joint-space inertia matrix ``H`` into ``h`` (nv, nv): the entries of every pair of degrees of
-    freedom on one path to the base (both triangles); the others are left as they were (zero in ``H``).
+    freedom on one path to the base (both triangles), the joints' armature on the diagonal; the others are left
+    as they were (zero in ``H``).
 
     Reads ``link_work[:, INERTIA_WORLD]`` and ``dof_motion``; writes ``link_work[:, COMPOSITE]``.
     """
@@ -121,6 +159,7 @@ def crba(link_ints, dof_ints, link_work, dof_motion, h):
             h[j, k] = value
             h[k, j] = value
             k = dof_ints[k, DOF_PARENT]
+        h[j, j] += dof_params[j, ARMATURE]
 
 
 @inline

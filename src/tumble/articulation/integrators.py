@@ -59,16 +59,16 @@ def accelerations(m, w, q, qd, tau, external, use_external):
     ``H`` by CRBA, its LTDL factor (left in ``w.mass_matrix`` for the projection), the solve, then the
     loop-closure correction (``loops.py``). Returns -1, or the row of a singular pivot.
     """
-    link_ints, world, dof_damping = m.link_ints, m.world, m.dof_damping
+    link_ints, world, dof_params = m.link_ints, m.world, m.dof_params
     link_work, dof_motion, dof_work, h = w.link_work, w.dof_motion, w.dof_work, w.mass_matrix
     forward_kinematics(link_ints, m.link_reals, world, q, qd, link_work, dof_motion)
     if m.loop_ints.shape[0] == 0:
-        return aba(link_ints, world, dof_damping, link_work, dof_motion, w.dof_u, dof_work[DIAG], qd, tau, external,
-                   use_external, dof_work[QDD])  # fmt: skip
+        return aba(link_ints, world, dof_params, link_work, dof_motion, w.dof_u, dof_work[DIAG], q, qd, tau,
+                   external, use_external, dof_work[QDD])  # fmt: skip
     at_rest = dof_work[RHS]  # the bias forces are the joint forces at q̈ = 0
     fill(at_rest, 0.0)
-    rnea(link_ints, world, dof_damping, link_work, dof_motion, qd, at_rest, external, use_external, dof_work[BIAS])
-    crba(link_ints, m.dof_ints, link_work, dof_motion, h)
+    rnea(link_ints, world, dof_params, link_work, dof_motion, q, qd, at_rest, external, use_external, dof_work[BIAS])
+    crba(link_ints, m.dof_ints, dof_params, link_work, dof_motion, h)
     bad = ltdl_factor(m.dof_ints, h, dof_work[DIAG])
     if bad >= 0:
         return bad
@@ -148,7 +148,7 @@ def step(m, w, q, qd, tau, external, use_external, h, method):
     # a tree's evaluation is called here directly, with the arrays it needs: passing the model and work
     # tuples through one more call per stage costs 10 % of a step of a 20-link chain
     tree = m.loop_ints.shape[0] == 0
-    link_reals, world, dof_damping = m.link_reals, m.world, m.dof_damping
+    link_reals, world, dof_params = m.link_reals, m.world, m.dof_params
     link_work, dof_motion, dof_u, pivots = w.link_work, w.dof_motion, w.dof_u, dof_work[DIAG]
     if method == RK4:
         qdd_sum, qd_sum, chart = dof_work[QDD_SUM], dof_work[QD_SUM], dof_work[CHART]
@@ -160,8 +160,8 @@ def step(m, w, q, qd, tau, external, use_external, h, method):
         for stage in range(4):
             if tree:
                 forward_kinematics(link_ints, link_reals, world, q_stage, qd_stage, link_work, dof_motion)
-                bad = aba(link_ints, world, dof_damping, link_work, dof_motion, dof_u, pivots, qd_stage, tau, external,
-                          use_external, qdd)  # fmt: skip
+                bad = aba(link_ints, world, dof_params, link_work, dof_motion, dof_u, pivots, q_stage, qd_stage, tau,
+                          external, use_external, qdd)  # fmt: skip
             else:
                 bad = accelerations(m, w, q_stage, qd_stage, tau, external, use_external)
             if bad >= 0:
@@ -187,7 +187,7 @@ def step(m, w, q, qd, tau, external, use_external, h, method):
     else:
         if tree:
             forward_kinematics(link_ints, link_reals, world, q, qd, link_work, dof_motion)
-            bad = aba(link_ints, world, dof_damping, link_work, dof_motion, dof_u, pivots, qd, tau, external,
+            bad = aba(link_ints, world, dof_params, link_work, dof_motion, dof_u, pivots, q, qd, tau, external,
                       use_external, qdd)  # fmt: skip
         else:
             bad = accelerations(m, w, q, qd, tau, external, use_external)

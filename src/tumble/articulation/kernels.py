@@ -10,8 +10,8 @@ return status codes that the facade turns into errors.
 
 from __future__ import annotations
 
-from .._jit import kernel
-from .dynamics import crba, rnea
+from .._jit import inline, kernel
+from .dynamics import crba, joint_energies, rnea
 from .integrators import accelerations, step
 from .kinematics import energies, forward_kinematics
 from .loops import loop_jacobian, project_loop_closures
@@ -21,6 +21,14 @@ from .spatial import assign, fill_matrix
 __all__ = ["FORWARD", "INVERSE", "KINEMATICS", "MASS_MATRIX", "PROJECT", "SIMULATE", "articulation_kernel"]
 
 KINEMATICS, INVERSE, MASS_MATRIX, FORWARD, PROJECT, SIMULATE = 0, 1, 2, 3, 4, 5
+
+
+@inline
+def _energies(m, w, q, qd):
+    """Kinetic and potential energy after the kinematics: the links', the joints' rotors' and springs'."""
+    kinetic, potential = energies(m.world, w.link_work)
+    rotors, springs = joint_energies(m.link_ints, m.dof_params, q, qd)
+    return kinetic + rotors, potential + springs
 
 
 @kernel
@@ -58,23 +66,23 @@ def articulation_kernel(ints, reals, q, qd, vec_in, external, use_external, work
     if mode != SIMULATE:
         forward_kinematics(m.link_ints, m.link_reals, m.world, q, qd, w.link_work, w.dof_motion)
         if mode == KINEMATICS:
-            w.energy[0], w.energy[1] = energies(m.world, w.link_work)
+            w.energy[0], w.energy[1] = _energies(m, w, q, qd)
             if m.loop_ints.shape[0] > 0:
                 loop_jacobian(m.link_ints, m.dof_ints, m.loop_ints, m.loop_reals, w.link_work, w.dof_motion,
                               w.loop_jac, w.loop_work)  # fmt: skip
         elif mode == INVERSE:
-            rnea(m.link_ints, m.world, m.dof_damping, w.link_work, w.dof_motion, qd, vec_in, external, use_external,
+            rnea(m.link_ints, m.world, m.dof_params, w.link_work, w.dof_motion, q, qd, vec_in, external, use_external,
                  vec_out)  # fmt: skip
         elif mode == MASS_MATRIX:
             fill_matrix(w.mass_matrix, 0.0)  # the CRBA writes only the entries of pairs on one path to the base
-            crba(m.link_ints, m.dof_ints, w.link_work, w.dof_motion, w.mass_matrix)
+            crba(m.link_ints, m.dof_ints, m.dof_params, w.link_work, w.dof_motion, w.mass_matrix)
         return 0, 0, -1
     nq, nv = q.shape[0], qd.shape[0]
     for n in range(steps + 1):
         # record (q, qd, energy) at frame 0 and after every record_every-th step
         if record.shape[0] > 0 and n % record_every == 0:
             forward_kinematics(m.link_ints, m.link_reals, m.world, q, qd, w.link_work, w.dof_motion)
-            kinetic, potential = energies(m.world, w.link_work)
+            kinetic, potential = _energies(m, w, q, qd)
             frame = n // record_every
             assign(record[frame, :nq], q)
             assign(record[frame, nq : nq + nv], qd)

@@ -46,6 +46,9 @@ POINT_A, POINT_B = 0, 3
 POS, QUAT, VEL, VEL_PRODUCT, ACC, FORCE, INERTIA_WORLD, COMPOSITE = 0, 3, 7, 13, 19, 25, 31, 41
 ART_INERTIA, ART_BIAS, ART_STORED = 51, 72, 78
 LINK_WORK_WIDTH = 79
+# dof_params columns: the joint's passive terms on each degree of freedom
+DAMPING, ARMATURE, STIFFNESS, SPRINGREF = 0, 1, 2, 3
+DOF_PARAM_WIDTH = 4
 # dof_work rows
 BIAS, RHS, QDD, DIAG, QD_START, QD_STAGE, QDD_SUM, QD_SUM, CHART = 0, 1, 2, 3, 4, 5, 6, 7, 8
 DOF_WORK_ROWS = 9
@@ -67,7 +70,9 @@ class Model(NamedTuple):
             (4): the link frame in the parent frame at zero displacement; ``MASS`` [kg]; ``COM`` (3) [m] and
             ``INERTIA`` (9) [kg m²] about it, link frame.
         dof_ints: (nv, 2) int64: ``DOF_PARENT`` (-1: none) and ``DOF_LINK``.
-        dof_damping: (nv,) joint damping [N m s/rad or N s/m].
+        dof_params: (nv, 4): ``DAMPING`` [N m s/rad or N s/m], ``ARMATURE`` (a rotor's inertia added to the
+            degree of freedom's own, [kg m²] or [kg]), ``STIFFNESS`` [N m/rad or N/m] and ``SPRINGREF`` (the
+            spring's rest coordinate) of the joint: the force ``-damping q̇ - stiffness (q - springref)``.
         world: (10,): ``GRAVITY`` (3) [m/s²], ``BASE_POS`` (3) [m], ``BASE_QUAT`` (4).
         loop_ints: (L, 2) int64: ``LINK_A``, ``LINK_B`` (-1: the world).
         loop_reals: (L, 6): ``POINT_A``, ``POINT_B`` [m], in the frames of link a and link b (or the world).
@@ -76,7 +81,7 @@ class Model(NamedTuple):
     link_ints: np.ndarray
     link_reals: np.ndarray
     dof_ints: np.ndarray
-    dof_damping: np.ndarray
+    dof_params: np.ndarray
     world: np.ndarray
     loop_ints: np.ndarray
     loop_reals: np.ndarray
@@ -125,7 +130,7 @@ def _int_size(n: int, nv: int, loops: int) -> int:
 
 
 def _real_size(n: int, nv: int, loops: int) -> int:
-    return WORLD_WIDTH + LINK_REAL_WIDTH * n + nv + 6 * loops
+    return WORLD_WIDTH + LINK_REAL_WIDTH * n + DOF_PARAM_WIDTH * nv + 6 * loops
 
 
 def work_size(n: int, nq: int, nv: int, loops: int) -> int:
@@ -156,8 +161,9 @@ def model_views(ints, reals):
     r = WORLD_WIDTH
     link_reals = _rows(reals, r, n, LINK_REAL_WIDTH)
     r += LINK_REAL_WIDTH * n
-    loop_reals = _rows(reals, r + nv, nl, 6)
-    return Model(link_ints, link_reals, dof_ints, reals[r : r + nv], reals[0:WORLD_WIDTH], loop_ints, loop_reals)
+    dof_params = _rows(reals, r, nv, DOF_PARAM_WIDTH)
+    loop_reals = _rows(reals, r + DOF_PARAM_WIDTH * nv, nl, 6)
+    return Model(link_ints, link_reals, dof_ints, dof_params, reals[0:WORLD_WIDTH], loop_ints, loop_reals)
 
 
 @inline
@@ -218,7 +224,7 @@ def pack_model(links, loops, gravity, base_pos, base_quat) -> tuple[np.ndarray, 
         above = -1 if link.parent is None else m.link_ints[link.parent, DOF_TIP]
         for k in range(link.v_slice.start, link.v_slice.stop):
             m.dof_ints[k] = (above, i)
-            m.dof_damping[k] = link.damping
+            m.dof_params[k] = (link.damping, link.armature, link.stiffness, link.springref)
             above = k
         m.link_ints[i] = (-1 if link.parent is None else link.parent, int(joint.type), link.q_slice.start,
                           link.v_slice.start, above)  # fmt: skip

@@ -87,6 +87,10 @@ def from_articulation(articulation, gravity=None, *, parameters=None) -> System:
             bodies.append(RigidBody(link.mass_properties, p, R, name=link.name))
     if not bodies:
         raise ValueError("articulation has no link with mass_properties: there is nothing to move")
+    for link in links.values():
+        if getattr(link, "armature", 0.0) != 0.0 or getattr(link, "stiffness", 0.0) != 0.0:
+            raise ValueError(f"link {_label(link)} has joint armature or stiffness, which the symbolic derivation "
+                             "does not model yet")  # fmt: skip
     damping = [-float(getattr(links[index], "damping", 0.0)) * q.diff() for index, q in coordinates.items()]
     g = articulation.gravity if gravity is None else gravity
     forces = damping if any(d != 0 for d in damping) else None

@@ -58,13 +58,19 @@ def to_articulation(model: ModelDescription) -> Articulation:
             name = body.name if last else _chain_name(body.name, joint.name, k)
             parent = art.add_link(link_joint, parent=parent, position=position, orientation=orientation,
                                   mass_properties=properties if last else None, damping=joint.damping,
-                                  name=name)  # fmt: skip
+                                  name=name, armature=joint.armature, stiffness=_spring(joint),
+                                  springref=joint.springref)  # fmt: skip
             if joint.type in ("hinge", "slide") and joint.ref != 0.0:
                 initial.append((parent, joint.ref))
         last_link[index] = (parent, joints[-1].pos)
     for link, ref in initial:
         art.set_joint(link, q=ref)
     return art
+
+
+def _spring(joint: JointDescription) -> float:
+    """A hinge's or slide's stiffness (tumble has no spring on a ball joint; the reader warns about one)."""
+    return joint.stiffness if joint.type in ("hinge", "slide") else 0.0
 
 
 def _chain_name(body: str | None, joint: str | None, k: int) -> str | None:

@@ -77,7 +77,7 @@ class _Reader:
     def warn_all(self, source: str) -> None:
         for (what, message), nodes in self.notes.items():
             more = f" and {len(nodes) - 1} more" if len(nodes) > 1 else ""
-            warnings.warn(f"{source}: {what} (line {nodes[0].line}{more}): {message}", MJCFWarning, stacklevel=4)
+            warnings.warn(f"{source}: {what} (line {nodes[0].line}{more}): {message}", MJCFWarning, stacklevel=5)
 
 
 # --- attributes --------------------------------------------------------------------------------------
@@ -233,11 +233,13 @@ def _joint(reader: _Reader, node: Node, childclass: str, is_top: bool) -> JointD
         frictionloss=_number(node, a, "frictionloss", 0.0, nonnegative=True),
         line=node.line,
     )
-    if np.any(_numbers(node, a, "stiffness", (1, 2, 3), [0.0]) != 0.0):
-        reader.note(node, "stiffness", "not simulated by tumble's Articulation (yet); ignored")
-    for name in ("armature", "frictionloss"):
-        if getattr(joint, name) != 0.0:
-            reader.note(node, name, "not simulated by tumble's Articulation (yet); ignored")
+    stiffness = _numbers(node, a, "stiffness", (1, 2, 3), [0.0])
+    if np.any(stiffness[1:] != 0.0):
+        reader.note(node, "stiffness", "only the linear spring (its first number) is simulated by tumble")
+    if stiffness[0] != 0.0 and kind in ("ball", "free"):
+        reader.note(node, "stiffness", f"a spring on a {kind} joint is not simulated by tumble; ignored")
+    if joint.frictionloss != 0.0:
+        reader.note(node, "frictionloss", "not simulated by tumble's Articulation (yet); ignored")
     if kind == "free" and "pos" in a and np.any(_numbers(node, a, "pos", 3)):
         reader.note(node, "pos", "ignored on a free joint: its coordinates are the body's pose")
     return joint
