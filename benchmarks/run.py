@@ -24,6 +24,8 @@ Run from the repository root:
                  and from scene files, beside MuJoCo compiling the same bodies from MJCF (``benchmarks/build.py``).
 ``first_run``    cold runs with an empty Numba cache: the flagship in one process and after ``tumble warmup --jobs 2``,
                  a sphere on a plane (``benchmarks/first_run.py``; only with ``--only``, about five minutes).
+``model_files``  loading MJCF: Gymnasium's humanoid and a 100-link chain, tumble's reader and builder beside MuJoCo's
+                 compiler (``benchmarks/model_files.py``).
 ``broad_phase``  world bounds and sort-and-sweep pairs alone, on a pile and a scatter of 1k and 5k shapes
                  (``benchmarks/broad_phase.py``; tumble only: no peer exposes its broad phase).
 
@@ -56,7 +58,7 @@ import numpy as np
 import tumble
 from tumble.dynamics import integrate
 
-from . import articulation, broad_phase, build, contact, first_run, joints, peers, quadrotor
+from . import articulation, broad_phase, build, contact, first_run, joints, model_files, peers, quadrotor
 
 __all__ = [
     "BENCHMARKS",
@@ -728,6 +730,9 @@ BENCHMARKS: dict[str, Callable[[Sizes], list[dict]]] = {
     "build": build.bench_build,
     "broad_phase": broad_phase.bench_broad_phase,
     "first_run": first_run.bench_first_run,
+    "model_files": lambda sizes: model_files.bench_model_files(
+        chain_links=100 if sizes.repeat > 1 else 5, repeat=max(1, min(sizes.repeat, 5))
+    ),
 }
 OPTIONAL = ("big_pyramid", "first_run")  # slow: run only when asked for with --only
 

@@ -255,6 +255,15 @@ def test_build_rows_for_every_world_and_way_and_the_same_world_each_way(tmp_path
         assert model.nbody - 1 == build.api_world(case, 30).model.body_count - (case == "free bodies")
 
 
+def test_model_files_rows_for_every_loader():
+    from benchmarks import model_files
+
+    rows = model_files.bench_model_files(chain_links=3, repeat=1)
+    _assert_finite_numbers(rows)
+    assert {r["model"] for r in rows} >= {"chain of 3"}
+    assert {r["loader"] for r in rows if r["model"] == "chain of 3"} >= {"tumble read_mjcf", "tumble from_mjcf"}
+
+
 def test_broad_phase_rows_for_both_worlds_and_pairs_in_the_pile():
     from benchmarks import broad_phase
 

@@ -35,6 +35,7 @@ _SILENT = {"site", "camera", "light", "visual", "statistic", "size", "asset", "t
            "skin", "custom", "extension"}  # fmt: skip
 # Attributes that only matter to collision or drawing, which an articulation has no use for.
 _COSMETIC = {"rgba", "material", "group", "user", "margin", "gap", "solref", "solimp", "solmix", "priority", "condim",
+             "hfield",
              "contype", "conaffinity", "friction", "solreflimit", "solimplimit", "solreffriction", "solimpfriction",
              "class", "childclass", "name", "texture", "emission", "specular", "shininess", "reflectance"}  # fmt: skip
 _JOINT = {"type", "pos", "axis", "range", "limited", "ref", "springref", "stiffness", "damping", "armature",
@@ -47,6 +48,9 @@ _COMPILER_READ = {"angle", "eulerseq", "inertiafromgeom", "boundmass", "boundine
                   "strippath"}  # fmt: skip
 _COMPILER_SWITCHES = {"balanceinertia", "fusestatic", "discardvisual", "alignfree"}  # fine while "false"
 _JOINT_TYPES = ("hinge", "slide", "ball", "free")
+# <option><flag>: switching these off changes what the articulation computes (gravity is read; contacts, limits and
+# the other constraints are not in an articulation, and the energy and solver switches change nothing it does)
+_FLAGS_THAT_MOVE = {"passive", "spring", "damper"}
 _GEOM_TYPES = ("plane", "hfield", "sphere", "capsule", "ellipsoid", "cylinder", "box", "mesh", "sdf")
 
 
@@ -370,7 +374,17 @@ def _read_option_extras(reader: _Reader, node: Node) -> None:
     if np.any(_numbers(node, node.attrib, "wind", 3, [0.0, 0.0, 0.0]) != 0.0):
         reader.note(node, "wind", "the medium's forces are not simulated by tumble; ignored")
     for child in node.children:
-        reader.note(child, "element", "not supported by tumble; ignored")
+        if child.tag != "flag":
+            reader.note(child, "element", "not supported by tumble; ignored")
+            continue
+        for name, value in child.attrib.items():
+            if name in _FLAGS_THAT_MOVE and value == "disable":
+                reader.note(child, name, "switching this off is not supported by tumble; ignored")
+
+
+def _gravity_switched_off(node: Node) -> bool:
+    """``<option><flag gravity="disable"/></option>``."""
+    return any(child.tag == "flag" and child.attrib.get("gravity") == "disable" for child in node.children)
 
 
 def _scaled_to_total(bodies: list[BodyDescription], total: float) -> list[BodyDescription]:
@@ -399,6 +413,8 @@ def describe(root: Node, base: Path) -> ModelDescription:
         if node.tag == "option":
             _read_option_extras(reader, node)
             gravity = _numbers(node, node.attrib, "gravity", 3, gravity)
+            if _gravity_switched_off(node):
+                gravity = np.zeros(3)
             timestep = _number(node, node.attrib, "timestep", timestep)
             if timestep <= 0:
                 raise node.error(f"timestep={node.attrib['timestep']!r} must be > 0")
