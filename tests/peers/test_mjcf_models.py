@@ -54,11 +54,12 @@ EXERCISE = """<mujoco model="exercise">
       <geom type="box" size="0.2 0.12 0.06"/>
       <geom type="ellipsoid" size="0.05 0.08 0.03" pos="0 0 0.1" axisangle="1 1 0 40"/>
       <body name="thigh" pos="0.2 0 0" childclass="limb" xyaxes="0 1 0 -1 0.2 0">
-        <joint name="hip_y" pos="0.01 0 0" ref="15" range="-60 60"/>
+        <joint name="hip_y" pos="0.01 0 0" ref="15" range="-60 60" armature="0.02" stiffness="3" springref="10"/>
         <joint name="hip_x" axis="1 0 0" pos="0.02 0.01 0"/>
         <geom fromto="0 0 0 0.3 0 -0.2"/>
         <body name="shin" pos="0.3 0 -0.2" zaxis="0.2 0.1 1">
-          <joint name="knee" type="slide" axis="0 0 1" ref="0.05" damping="1.5"/>
+          <joint name="knee" type="slide" axis="0 0 1" ref="0.05" damping="1.5" stiffness="40" springref="-0.02"
+                 armature="0.01"/>
           <geom class="heavy" type="cylinder" fromto="0 0 0 0 0 -0.3" size="0.03"/>
           <body name="foot" pos="0 0.1 -0.3" quat="0.9 0.1 -0.2 0.3">
             <joint type="ball" pos="0 0 0.02"/>

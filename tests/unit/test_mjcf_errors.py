@@ -45,6 +45,7 @@ def quiet(text):
          "in a top-level body"),
         (model('<body><geom type="box" size="1 0 1"/></body>'), r"<geom>: size='1 0 1': a box needs 3 positive"),
         (model('<body><joint axis="0 0 0"/><geom size="1"/></body>'), r"<joint>: axis='0 0 0' is zero"),
+        (model('<body><joint stiffness="-1"/><geom size="1"/></body>'), r"<joint>: stiffness='-1' must be >= 0"),
         (model('<body><geom type="capsule" fromto="0 0 0 0 0 0" size="1"/></body>'), r"fromto=.* has zero length"),
         (model("", '<compiler coordinate="global"/>'), r"coordinate='global' was removed"),
         (model('<include file="missing.xml"/>'), r"<include>: include file='missing.xml': no such file"),
@@ -90,6 +91,18 @@ def test_each_unsupported_element_and_attribute_warns_once_with_its_first_line_a
         "<string>: <joint> frictionloss (line 2 and 1 more): not simulated by tumble's Articulation (yet); ignored",
         "<string>: <tendon> element (line 1): not loaded into an Articulation; ignored",
     ]
+
+
+def test_a_chain_of_bodies_deeper_than_pythons_recursion_limit_loads(tmp_path):
+    depth = 1100  # Python's default limit is 1000 frames
+    body = '<geom size="0.01"/>'
+    for i in reversed(range(depth)):
+        body = f'<body name="b{i}" pos="0 0 -0.1"><joint/>{body}</body>'
+    (tmp_path / "chain.xml").write_text('<mujoco><worldbody><include file="links.xml"/></worldbody></mujoco>')
+    (tmp_path / "links.xml").write_text(f"<mujoco>{body}</mujoco>")
+    bodies = read_mjcf(tmp_path / "chain.xml").bodies
+    assert [b.parent for b in bodies] == list(range(-1, depth - 1))
+    assert bodies[-1].name == f"b{depth - 1}" and bodies[-1].mass_properties is not None
 
 
 def test_a_supported_file_loads_without_a_warning():

@@ -26,7 +26,9 @@ _WELD = JointDescription(None, "fixed", np.zeros(3), np.zeros(3), None, 0.0, 0.0
 def _link_joint(joint: JointDescription, position: np.ndarray, orientation: np.ndarray):
     """tumble's joint for ``joint`` and its link frame, turned (or moved) back by ``ref``."""
     if joint.type == "hinge":
-        return Revolute(joint.axis), position, quat_multiply(orientation, quat_from_axis_angle(joint.axis, -joint.ref))
+        if joint.ref != 0.0:
+            orientation = quat_multiply(orientation, quat_from_axis_angle(joint.axis, -joint.ref))
+        return Revolute(joint.axis), position, orientation
     if joint.type == "slide":
         return Prismatic(joint.axis), position - joint.ref * quat_rotate(orientation, joint.axis), orientation
     if joint.type == "ball":

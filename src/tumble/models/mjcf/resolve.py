@@ -35,9 +35,9 @@ _SILENT = {"site", "camera", "light", "visual", "statistic", "size", "asset", "t
            "skin", "custom", "extension"}  # fmt: skip
 # Attributes that only matter to collision or drawing, which an articulation has no use for.
 _COSMETIC = {"rgba", "material", "group", "user", "margin", "gap", "solref", "solimp", "solmix", "priority", "condim",
-             "hfield",
-             "contype", "conaffinity", "friction", "solreflimit", "solimplimit", "solreffriction", "solimpfriction",
-             "class", "childclass", "name", "texture", "emission", "specular", "shininess", "reflectance"}  # fmt: skip
+             "hfield", "contype", "conaffinity", "friction", "solreflimit", "solimplimit", "solreffriction",
+             "solimpfriction", "class", "childclass", "name", "texture", "emission", "specular", "shininess",
+             "reflectance"}  # fmt: skip
 _JOINT = {"type", "pos", "axis", "range", "limited", "ref", "springref", "stiffness", "damping", "armature",
           "frictionloss", "actuatorfrcrange", "actuatorfrclimited"}  # fmt: skip
 _GEOM = {"type", "size", "fromto", "pos", "mass", "density", "shellinertia", "mesh", *ORIENTATIONS}
@@ -208,8 +208,11 @@ def _joint(reader: _Reader, node: Node, childclass: str, is_top: bool) -> JointD
         if np.linalg.norm(axis) < 1e-14:
             raise node.error(f"axis={a['axis']!r} is zero")
         axis = axis / np.linalg.norm(axis)
-    angular = kind in ("hinge", "ball") and reader.compiler.degrees
-    scale = np.pi / 180.0 if angular else 1.0
+    # angles (a hinge's or ball's range, a hinge's ref and springref) in the compiler's unit
+    scale = np.pi / 180.0 if kind in ("hinge", "ball") and reader.compiler.degrees else 1.0
+    stiffness = _numbers(node, a, "stiffness", (1, 2, 3), [0.0])
+    if stiffness[0] < 0.0:
+        raise node.error(f"stiffness={a['stiffness']!r} must be >= 0")
     limited = _flag(node, a, "limited", "auto")
     has_range = "range" in a
     if limited == "auto" and not reader.compiler.autolimits and has_range:
@@ -222,22 +225,20 @@ def _joint(reader: _Reader, node: Node, childclass: str, is_top: bool) -> JointD
             raise node.error(f"range={a.get('range')!r} must have its lower bound below the upper")
         bounds = (float(low), float(high))
         reader.note(node, "range", "joint limits are not enforced by tumble's Articulation (yet); ignored")
-    ref_scale = np.pi / 180.0 if kind == "hinge" and reader.compiler.degrees else 1.0
     joint = JointDescription(
         name=a.get("name"),
         type=kind,
         pos=_numbers(node, a, "pos", 3, [0.0, 0.0, 0.0]) if kind != "free" else np.zeros(3),
         axis=axis,
         range=bounds,
-        ref=_number(node, a, "ref", 0.0) * ref_scale,
-        springref=_number(node, a, "springref", 0.0) * ref_scale,
-        stiffness=float(_numbers(node, a, "stiffness", (1, 2, 3), [0.0])[0]),
+        ref=_number(node, a, "ref", 0.0) * scale,
+        springref=_number(node, a, "springref", 0.0) * scale,
+        stiffness=float(stiffness[0]),
         damping=_number(node, a, "damping", 0.0, nonnegative=True),
         armature=_number(node, a, "armature", 0.0, nonnegative=True),
         frictionloss=_number(node, a, "frictionloss", 0.0, nonnegative=True),
         line=node.line,
     )
-    stiffness = _numbers(node, a, "stiffness", (1, 2, 3), [0.0])
     if np.any(stiffness[1:] != 0.0):
         reader.note(node, "stiffness", "only the linear spring (its first number) is simulated by tumble")
     if stiffness[0] != 0.0 and kind in ("ball", "free"):
@@ -326,7 +327,9 @@ def _inertial(reader: _Reader, node: Node) -> MassProperties:
         raise node.error(f"non-physical inertia: {error}") from None
 
 
-def _body(reader: _Reader, node: Node, parent: int, childclass: str, out: list[BodyDescription]) -> None:
+def _body(reader: _Reader, node: Node, parent: int, childclass: str,
+          out: list[BodyDescription]) -> tuple[list[Node], str]:  # fmt: skip
+    """Append the body ``node``; return its child bodies and the class they inherit."""
     a = node.attrib
     _check_known(reader, node, a, _BODY)
     childclass = a.get("childclass", childclass)
@@ -360,9 +363,18 @@ def _body(reader: _Reader, node: Node, parent: int, childclass: str, out: list[B
         quat=_frame_quat(reader, node, a), mass_properties=properties, joints=tuple(joints), geoms=tuple(geoms),
         line=node.line,
     ))  # fmt: skip
-    index = len(out) - 1
-    for child in children:
-        _body(reader, child, index, childclass, out)
+    return children, childclass
+
+
+def _body_tree(reader: _Reader, top: Node, out: list[BodyDescription]) -> None:
+    """The bodies from ``top`` down in document order (parents first: MuJoCo's numbering), on a stack of its own:
+    a chain of a thousand nested bodies is past Python's recursion limit."""
+    stack = [(top, -1, "main")]
+    while stack:
+        node, parent, childclass = stack.pop()
+        children, childclass = _body(reader, node, parent, childclass, out)
+        index = len(out) - 1
+        stack.extend((child, index, childclass) for child in reversed(children))
 
 
 def _read_option_extras(reader: _Reader, node: Node) -> None:
@@ -423,7 +435,7 @@ def describe(root: Node, base: Path) -> ModelDescription:
         elif node.tag == "worldbody":
             for child in node.children:
                 if child.tag == "body":
-                    _body(reader, child, -1, "main", bodies)
+                    _body_tree(reader, child, bodies)
                 elif child.tag == "geom":
                     world_geoms.append(_geom(reader, child, "main")[0])
                 elif child.tag not in _SILENT:

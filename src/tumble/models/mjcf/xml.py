@@ -7,6 +7,7 @@ the tree is built here from ``xml.parsers.expat`` events (attributes and childre
 from __future__ import annotations
 
 import os
+from collections import deque
 from dataclasses import dataclass, field
 from pathlib import Path
 from xml.parsers import expat
@@ -73,30 +74,41 @@ def read_model(path_or_xml: str | os.PathLike) -> tuple[Node, Path]:
     return root, base
 
 
-def _expand_includes(node: Node, model_dir: Path, here: Path, chain: list[str]) -> None:
+def _expand_includes(root: Node, model_dir: Path, here: Path, chain: list[str]) -> None:
     """Replace each ``<include file=...>`` by the children of the included file's ``<mujoco>`` (a path relative to
     the main file's directory, else to the including file's, as MuJoCo finds it), refusing loops and paths that
-    leave the model's directory."""
-    expanded: list[Node] = []
-    for child in node.children:
-        if child.tag != "include":
-            _expand_includes(child, model_dir, here, chain)
-            expanded.append(child)
-            continue
-        name = child.attrib.get("file")
-        if not name:
-            raise child.error("include needs a file attribute")
-        # MuJoCo looks beside the main file first, then beside the including file (measured with MuJoCo 4).
-        target = (model_dir / name).resolve()
-        if not target.is_file():
-            target = (here / name).resolve()
-        if not target.is_relative_to(model_dir):
-            raise child.error(f"include file={name!r} leaves the model's directory {model_dir}")
-        if str(target) in chain:
-            raise child.error(f"include file={name!r} includes itself (through {' -> '.join(chain)})")
-        if not target.is_file():
-            raise child.error(f"include file={name!r}: no such file ({target})")
-        included = _parse(target.read_bytes(), str(target))
-        _expand_includes(included, model_dir, target.parent, [*chain, str(target)])
-        expanded.extend(included.children)
-    node.children = expanded
+    leave the model's directory. A walk with its own stack: a chain of a thousand nested bodies is a thousand
+    levels deep, past Python's recursion limit."""
+    nodes = [(root, here, chain)]
+    while nodes:
+        node, node_here, node_chain = nodes.pop()
+        pending = deque((child, node_here, node_chain) for child in node.children)
+        expanded: list[Node] = []
+        while pending:
+            child, child_here, child_chain = pending.popleft()
+            if child.tag != "include":
+                expanded.append(child)
+                nodes.append((child, child_here, child_chain))
+                continue
+            included, target = _included(child, model_dir, child_here, child_chain)
+            inner = [*child_chain, str(target)]
+            pending.extendleft((grandchild, target.parent, inner) for grandchild in reversed(included.children))
+        node.children = expanded
+
+
+def _included(child: Node, model_dir: Path, here: Path, chain: list[str]) -> tuple[Node, Path]:
+    """The ``<mujoco>`` tree that ``child`` (an ``<include>``) names, and its path."""
+    name = child.attrib.get("file")
+    if not name:
+        raise child.error("include needs a file attribute")
+    # MuJoCo looks beside the main file first, then beside the including file (measured with MuJoCo 4).
+    target = (model_dir / name).resolve()
+    if not target.is_file():
+        target = (here / name).resolve()
+    if not target.is_relative_to(model_dir):
+        raise child.error(f"include file={name!r} leaves the model's directory {model_dir}")
+    if str(target) in chain:
+        raise child.error(f"include file={name!r} includes itself (through {' -> '.join(chain)})")
+    if not target.is_file():
+        raise child.error(f"include file={name!r}: no such file ({target})")
+    return _parse(target.read_bytes(), str(target)), target
