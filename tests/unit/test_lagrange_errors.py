@@ -291,3 +291,13 @@ def test_balancing_reports_unknowns_that_are_not_determined(pendulum):
     tau1, tau2 = sp.symbols("tau1 tau2")
     with pytest.raises(ValueError, match="not determined"):
         pendulum.balancing([tau1, tau2], [0.3], VALUES, applied=[tau1 + tau2])
+
+
+@pytest.mark.parametrize("passive", [{"armature": 0.1}, {"stiffness": 2.0}])
+def test_an_articulation_with_armature_or_springs_is_refused_by_name(passive):
+    from tumble.articulation import Articulation, Revolute
+
+    art = Articulation()
+    art.add_link(Revolute((0, 1, 0)), mass=1.0, shape_position=(0.0, 0.0, -1.0), name="arm", **passive)
+    with pytest.raises(ValueError, match=r"link 0 \('arm'\) has joint armature or stiffness"):
+        lagrange.from_articulation(art)
