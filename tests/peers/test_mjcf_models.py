@@ -1,12 +1,13 @@
 """MJCF files nobody here wrote, loaded by tumble and by MuJoCo: the compiled models and their dynamics compared.
 
-MuJoCo is the oracle for what a file means. Gymnasium's MuJoCo assets (ant, half_cheetah, hopper, humanoid, …) and
-models written here to exercise the rest of the format (default classes, childclass, every orientation, fromto,
-refs, several joints in a body, ``inertial`` and geoms) are read by :func:`tumble.articulation.from_mjcf` and by
-``mujoco.MjModel``; bodies, masses, inertias, joint frames, mass matrices and accelerations must agree to round-off.
-Armature, joint damping and springs are simulated by both; what tumble's articulation does not simulate yet (joint
-friction, a viscous medium, limits, tendons) is switched off on MuJoCo's side through ``MjSpec`` and reported by
-tumble's warnings.
+MuJoCo is the oracle for what a file means. Gymnasium's MuJoCo assets (ant, half_cheetah, hopper, humanoid, …),
+dm_control's suite (the dog with its 162 bone meshes included) and models written here to exercise the rest of the
+format (default classes, childclass, every orientation, fromto, refs, several joints in a body, ``inertial`` and
+geoms) are read by :func:`tumble.articulation.from_mjcf` and by ``mujoco.MjModel``; bodies, masses, inertias, joint
+frames, mass matrices and accelerations must agree to round-off (tests/peers/test_mjcf_meshes.py has the small mesh
+cases). Armature, joint damping and springs (``springdamper`` too) are simulated by both; what tumble's articulation
+does not simulate yet (joint friction, a viscous medium, limits, tendons) is switched off on MuJoCo's side through
+``MjSpec`` and reported by tumble's warnings.
 """
 
 from __future__ import annotations
@@ -14,11 +15,14 @@ from __future__ import annotations
 import importlib.util
 import os
 import warnings
+from dataclasses import replace
 
 import numpy as np
 import pytest
 
 from tumble.articulation import from_mjcf
+from tumble.mass import MassProperties
+from tumble.models.build import to_articulation
 from tumble.models.mjcf import MJCFWarning, read_mjcf
 from tumble.rotation import quat_to_matrix
 
@@ -32,8 +36,10 @@ GYMNASIUM = sorted(name for name in os.listdir(ASSETS) if name.endswith(".xml"))
 _DM_CONTROL = importlib.util.find_spec("dm_control")
 SUITE_DIR = os.path.join(os.path.dirname(_DM_CONTROL.origin), "suite") if _DM_CONTROL else None
 SUITE = sorted(f"suite/{n}" for n in os.listdir(SUITE_DIR) if n.endswith(".xml")) if SUITE_DIR else []
-# Mesh geoms carry mass in MuJoCo; tumble does not compute a mesh's yet (and warns)
-WITH_MESH_MASS = {"suite/dog.xml"}
+# MuJoCo turns each mesh's inertia to its principal axes by a Jacobi iteration that stops when the off-diagonal
+# terms of the per-unit-density tensor fall under 1e-12 m⁵ (mju_eig3's absolute threshold): a mesh geom's inertia in
+# MuJoCo's compiled model is off by up to that, times the geom's density. tumble keeps the tensor as integrated.
+EIG3_THRESHOLD = 1e-12
 
 EXERCISE = """<mujoco model="exercise">
   <compiler angle="degree" eulerseq="zyX" autolimits="true"/>
@@ -92,8 +98,30 @@ def _switch_off(element, name: str) -> None:
         setattr(element, name, 0.0)
 
 
-def _load(name: str):
-    """tumble's articulation and description, and MuJoCo's model with what tumble does not simulate switched off."""
+def _mesh_density(spec) -> dict[str, float]:
+    """Each body's mesh geoms' densities, summed."""
+    return {body.name: sum(g.density for g in body.geoms if g.type == mujoco.mjtGeom.mjGEOM_MESH)
+            for body in spec.bodies}  # fmt: skip
+
+
+def _with_mujocos_inertia(description, model):
+    """The description with each body's mass properties as MuJoCo compiled them, for the dynamics compared on the
+    same inertias where MuJoCo's eigen-solver rounds a mesh's (``EIG3_THRESHOLD``; the difference is bounded in
+    the test of the compiled model)."""
+    bodies = []
+    for index, body in enumerate(description.bodies, start=1):
+        if body.mass_properties is not None:
+            rotation = quat_to_matrix(model.body_iquat[index])
+            inertia = rotation @ np.diag(model.body_inertia[index]) @ rotation.T
+            body = replace(body, mass_properties=MassProperties(model.body_mass[index], model.body_ipos[index],
+                                                                0.5 * (inertia + inertia.T)))  # fmt: skip
+        bodies.append(body)
+    return replace(description, bodies=tuple(bodies))
+
+
+def _load(name: str, mujocos_mesh_inertia: bool = False):
+    """tumble's articulation and description, and MuJoCo's model with what tumble does not simulate switched off
+    (with ``mujocos_mesh_inertia``, a model with mesh geoms is built on MuJoCo's compiled inertias)."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", MJCFWarning)
         art, description = from_mjcf(_source(name)), read_mjcf(_source(name))
@@ -109,17 +137,20 @@ def _load(name: str):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # half_cheetah's deprecated settotalmass
         model = spec.compile()
+    if mujocos_mesh_inertia and any(_mesh_density(spec).values()):
+        art = to_articulation(_with_mujocos_inertia(description, model))
     return art, description, model
 
 
 NAMES = ["exercise", *GYMNASIUM, *SUITE]
-_NO_MESH_MASS = pytest.mark.skip(reason="mesh geoms' mass not computed by tumble yet")
-MODELS = [pytest.param(name, marks=_NO_MESH_MASS) if name in WITH_MESH_MASS else name for name in NAMES]
+MODELS = NAMES
 
 
 @pytest.mark.parametrize("name", MODELS)
 def test_bodies_masses_inertias_and_joints_equal_mujocos_compiled_model(name):
     _, description, model = _load(name)
+    spec = mujoco.MjSpec.from_string(EXERCISE) if name == "exercise" else mujoco.MjSpec.from_file(_source(name))
+    mesh_density = _mesh_density(spec)
     assert len(description.bodies) == model.nbody - 1
     for index, body in enumerate(description.bodies, start=1):
         assert body.name == (model.body(index).name or None)
@@ -132,7 +163,8 @@ def test_bodies_masses_inertias_and_joints_equal_mujocos_compiled_model(name):
             np.testing.assert_allclose(mp.com, model.body_ipos[index], rtol=0, atol=1e-12)
             rotation = quat_to_matrix(model.body_iquat[index])
             tensor = rotation @ np.diag(model.body_inertia[index]) @ rotation.T
-            np.testing.assert_allclose(mp.inertia, tensor, rtol=0, atol=1e-9 * max(np.abs(tensor).max(), 1e-12))
+            eig3 = EIG3_THRESHOLD * mesh_density.get(body.name, 0.0)
+            np.testing.assert_allclose(mp.inertia, tensor, rtol=0, atol=1e-9 * max(np.abs(tensor).max(), 1e-12) + eig3)
         first = model.body_jntadr[index]
         assert len(body.joints) == model.body_jntnum[index]
         for k, joint in enumerate(body.joints):
@@ -141,7 +173,10 @@ def test_bodies_masses_inertias_and_joints_equal_mujocos_compiled_model(name):
             if joint.type in ("hinge", "slide"):
                 np.testing.assert_allclose(joint.axis, model.jnt_axis[j], rtol=0, atol=1e-12)
                 np.testing.assert_allclose(joint.pos, model.jnt_pos[j], rtol=0, atol=1e-12)
-                assert joint.damping == model.dof_damping[model.jnt_dofadr[j]]
+                # springdamper's are computed from the effective mass: equal to round-off
+                assert joint.damping == pytest.approx(model.dof_damping[model.jnt_dofadr[j]], rel=1e-12)
+                stiffness = np.atleast_1d(model.jnt_stiffness[j])[0]  # MuJoCo 4: a polynomial's coefficients
+                assert joint.stiffness == pytest.approx(stiffness, rel=1e-12)
 
 
 def _random_state(model, rng):
@@ -155,7 +190,7 @@ def _random_state(model, rng):
 
 @pytest.mark.parametrize("name", MODELS)
 def test_link_frames_mass_matrix_and_accelerations_equal_mujocos(name):
-    art, description, model = _load(name)
+    art, description, model = _load(name, mujocos_mesh_inertia=True)
     if model.nv == 0:
         pytest.skip("nothing in this model moves")
     data = mujoco.MjData(model)
@@ -200,14 +235,14 @@ def test_the_warnings_name_what_is_not_simulated_once_each_with_its_line():
 # Models tuned for MuJoCo's Euler, whose damping is implicit: without their contacts and limits, a light link behind
 # a damped joint is too stiff for explicit RK4 at the model's timestep, in MuJoCo as in tumble (MuJoCo's RK4 resets
 # the manipulator and the stacker after a few steps, and amplifies round-off on the reacher and the quadruped until
-# the engines part by 1e-6 within the 2 s). These run at a fraction of their timestep, where both agree to 1e-12.
-RK4_SUBSTEPS = {"suite/finger.xml": 10, "suite/quadruped.xml": 10, "suite/reacher.xml": 10,
+# the engines part by 1e-6 within the 2 s; the dog's tail joints, whose springdamper="0.001 50" damps at 2/τ =
+# 2000 /s, blow up in both at once). These run at a fraction of their timestep, where both agree to 1e-12.
+RK4_SUBSTEPS = {"suite/dog.xml": 10, "suite/finger.xml": 10, "suite/quadruped.xml": 10, "suite/reacher.xml": 10,
                 "suite/manipulator.xml": 100, "suite/stacker.xml": 100}  # fmt: skip
 
 
 RK4_MODELS = [
-    pytest.param(name, marks=_NO_MESH_MASS) if name in WITH_MESH_MASS
-    else pytest.param(name, marks=pytest.mark.slow) if RK4_SUBSTEPS.get(name, 1) > 10  # 200 000 steps: 10 s
+    pytest.param(name, marks=pytest.mark.slow) if RK4_SUBSTEPS.get(name, 1) > 10  # 200 000 steps: 10 s
     else name
     for name in NAMES
 ]  # fmt: skip
@@ -218,7 +253,7 @@ def test_rk4_tracks_mujocos_rk4_for_two_seconds(name):
     """Both engines integrate the model by RK4 at its own timestep (or a fraction, see ``RK4_SUBSTEPS``) from the
     same state: the same motion, the difference growing from round-off (contacts, limits and what tumble does not
     simulate switched off)."""
-    art, _, model = _load(name)
+    art, _, model = _load(name, mujocos_mesh_inertia=True)
     if model.nv == 0:
         pytest.skip("nothing in this model moves")
     model.opt.integrator = mujoco.mjtIntegrator.mjINT_RK4

@@ -144,3 +144,65 @@ def test_euler_sequences_turn_with_the_frame_in_lowercase_and_about_fixed_axes_i
     for seq, expected in (("xyz", quat_multiply(x, z)), ("XYZ", quat_multiply(z, x))):
         body = quiet(model('<body euler="0.3 0 0.5"><geom size="1"/></body>', head.format(seq))).bodies[0]
         np.testing.assert_allclose(body.quat, expected, atol=1e-15)
+
+
+TETRA = "0 0 0 1 0 0 0 1 0 0 0 1"
+
+
+def mesh_model(asset: str, geom: str = "type='mesh' mesh='m'") -> str:
+    return f"<mujoco><asset>{asset}</asset><worldbody><body><freejoint/><geom {geom}/></body></worldbody></mujoco>"
+
+
+@pytest.mark.parametrize(
+    ("text", "match"),
+    [
+        (mesh_model(f"<mesh name='m' vertex='{TETRA}'/>", "type='mesh'"), r"<geom>: a mesh geom needs mesh=\.\.\."),
+        (mesh_model(f"<mesh name='m' vertex='{TETRA}'/>", "type='mesh' mesh='n'"), r"<geom>: mesh='n' names no "
+         "<mesh> asset"),
+        (mesh_model("<mesh name='m' vertex='0 0 0 1 0 0 0 1 0'/>"), r"<mesh>: vertex holds 9 numbers: at least four"),
+        (mesh_model(f"<mesh name='m' vertex='{TETRA}' face='0 1 7'/>"), r"<mesh>: face indexes vertices outside "
+         r"0\.\.3"),
+        (mesh_model(f"<mesh name='m' vertex='{TETRA}' face='0 1 2.5'/>"), r"<mesh>: face=.* is not a list of integer"),
+        (mesh_model("<mesh name='m' vertex='0 0 0 1 0 0 0 1 0 1 1 0'/>"), r"line 1, <mesh>: mesh 'm': its vertices "
+         "span no volume"),
+        (mesh_model(f"<mesh name='m' vertex='{TETRA}' face='0 1 2 0 1 3 0 2 3 1 2 3' inertia='exact'/>"),
+         r"<mesh>: mesh 'm' \(<string>\): its faces are inconsistently wound"),
+        (mesh_model(f"<mesh name='m' vertex='{TETRA}' face='0 1 2 0 3 1 0 2 3 1 3 2' inertia='exact'/>"),
+         r"its volume is negative .*: the faces point inwards"),
+        (mesh_model(f"<mesh name='m' vertex='{TETRA}' face='0 2 1'/>"), r"its volume is too small"),
+        (mesh_model(f"<mesh name='m' vertex='{TETRA}' inertia='hollow'/>"), r"inertia='hollow' must be one of legacy"),
+        (mesh_model(f"<mesh name='m' vertex='{TETRA}'/><mesh name='m' vertex='{TETRA}'/>"), r"mesh 'm' is defined "
+         "twice"),
+        (mesh_model(f"<mesh name='m' vertex='{TETRA}'/>", "type='mesh' mesh='m' shellinertia='true'"), r"shellinertia"
+         " on a mesh geom"),
+        (mesh_model(f"<mesh name='m' vertex='{TETRA}' file='a.stl'/>"), r"from a file or from vertex=\.\.\., one"),
+        (mesh_model("<mesh file='missing.stl'/>", "type='mesh' mesh='missing'"), r"<mesh>: file='missing\.stl': no "
+         "such mesh file"),
+        (mesh_model("<mesh file='../../etc/passwd.stl'/>"), r"file='\.\./\.\./etc/passwd\.stl' leaves the mesh "
+         "directory"),
+        (model("<body><geom type='capsule' pos='0 0 1' fromto='0 0 0 0 0 1' size='0.1'/></body>"), r"give pos or "
+         "fromto, not both"),
+    ],
+)  # fmt: skip
+def test_a_bad_mesh_gives_one_error_naming_the_element_and_line(text, match):
+    with pytest.raises(MJCFError, match=match):
+        quiet(text)
+
+
+def test_a_mesh_file_of_an_unknown_kind_or_unreadable_is_an_error_naming_it(tmp_path):
+    (tmp_path / "part.ply").write_text("ply")
+    (tmp_path / "model.xml").write_text(mesh_model("<mesh file='part.ply'/>", "type='mesh' mesh='part'"))
+    with pytest.raises(MJCFError, match=r"model\.xml, line 1, <mesh>: file='part\.ply': a mesh file is \.stl"):
+        read_mjcf(tmp_path / "model.xml")
+    (tmp_path / "part.msh").write_bytes(b"\x04\x00\x00\x00")
+    (tmp_path / "model.xml").write_text(mesh_model("<mesh file='part.msh'/>", "type='mesh' mesh='part'"))
+    with pytest.raises(MJCFError, match=r"part\.msh is not an MSH file: 4 bytes"):
+        read_mjcf(tmp_path / "model.xml")
+
+
+def test_a_mesh_used_by_no_geom_or_a_primitive_shell_loads_and_an_ellipsoid_shell_warns():
+    text = mesh_model(f"<mesh name='m' vertex='{TETRA}'/>", "type='ellipsoid' size='0.1 0.2 0.3' shellinertia='true'")
+    with pytest.warns(MJCFWarning, match=r"<geom> shellinertia \(line 1\): not computed by tumble for an ellipsoid"):
+        description = read_mjcf(text)
+    assert description.meshes["m"].faces.shape == (4, 3)  # the hull of four vertices
+    assert description.bodies[0].mass_properties.mass == pytest.approx(1000 * 4 / 3 * np.pi * 0.006)

@@ -14,7 +14,7 @@ import numpy as np
 
 from ..mass import MassProperties
 
-__all__ = ["BodyDescription", "GeomDescription", "JointDescription", "ModelDescription"]
+__all__ = ["BodyDescription", "GeomDescription", "JointDescription", "MeshDescription", "ModelDescription"]
 
 
 @dataclass(frozen=True)
@@ -33,6 +33,8 @@ class JointDescription:
     armature: float
     frictionloss: float
     line: int
+    # MJCF's (time constant [s], damping ratio) that sized ``stiffness`` and ``damping`` from the joint's mass
+    springdamper: tuple[float, float] | None = None
 
 
 @dataclass(frozen=True)
@@ -48,6 +50,20 @@ class GeomDescription:
     contype: int
     conaffinity: int
     friction: np.ndarray  # (3,) sliding, torsional, rolling
+    line: int
+    mesh: str | None = None  # a mesh geom's mesh (``ModelDescription.meshes``); a primitive fitted to one names it
+
+
+@dataclass(frozen=True)
+class MeshDescription:
+    """A triangle mesh asset in its own frame (the frame a mesh geom's ``pos``/``quat`` place). ``inertia`` says how
+    a geom of it spreads its mass: ``"legacy"``, ``"exact"``, ``"convex"`` (a solid) or ``"shell"`` (the surface)."""
+
+    name: str
+    vertices: np.ndarray  # (n, 3) [m]
+    faces: np.ndarray  # (f, 3) vertex indices, counter-clockwise seen from outside
+    inertia: str
+    source: str  # the file it was read from, or the model's for vertices written in it
     line: int
 
 
@@ -76,6 +92,7 @@ class ModelDescription:
     gravity: np.ndarray = field(default_factory=lambda: np.array([0.0, 0.0, -9.81]))
     timestep: float = 0.002
     integrator: str = "Euler"
+    meshes: dict[str, MeshDescription] = field(default_factory=dict)
 
     def body_index(self, name: str) -> int:
         for index, body in enumerate(self.bodies):

@@ -17,10 +17,20 @@ from pathlib import Path
 import numpy as np
 
 from ...mass import MassProperties
-from ...rotation import quat_to_matrix
-from ..description import BodyDescription, GeomDescription, JointDescription, ModelDescription
+from ...rotation import quat_multiply, quat_rotate, quat_to_matrix
+from ..description import BodyDescription, GeomDescription, JointDescription, MeshDescription, ModelDescription
 from .frames import ORIENTATIONS, orientation, quat_z_to
-from .inertia import VOLUME_TYPES, bounded, geom_mass_properties, geom_volume
+from .inertia import (
+    SHELL_TYPES,
+    VOLUME_TYPES,
+    bounded,
+    geom_area,
+    geom_mass_properties,
+    geom_volume,
+    shell_mass_properties,
+)
+from .mesh_inertia import MeshInertia, mesh_inertia
+from .meshes import MESH_ATTRIBUTES, MESH_COSMETIC, read_mesh
 from .xml import Node
 
 __all__ = ["MJCFWarning", "describe"]
@@ -31,21 +41,21 @@ class MJCFWarning(UserWarning):
 
 
 # Elements that hold nothing an articulation simulates: read past without a word.
-_SILENT = {"site", "camera", "light", "visual", "statistic", "size", "asset", "texture", "material", "hfield",
-           "skin", "custom", "extension"}  # fmt: skip
+_SILENT = {"site", "camera", "light", "visual", "statistic", "size", "texture", "material", "hfield", "skin",
+           "custom", "extension"}  # fmt: skip
 # Attributes that only matter to collision or drawing, which an articulation has no use for.
 _COSMETIC = {"rgba", "material", "group", "user", "margin", "gap", "solref", "solimp", "solmix", "priority", "condim",
              "hfield", "contype", "conaffinity", "friction", "solreflimit", "solimplimit", "solreffriction",
              "solimpfriction", "class", "childclass", "name", "texture", "emission", "specular", "shininess",
              "reflectance"}  # fmt: skip
 _JOINT = {"type", "pos", "axis", "range", "limited", "ref", "springref", "stiffness", "damping", "armature",
-          "frictionloss", "actuatorfrcrange", "actuatorfrclimited"}  # fmt: skip
-_GEOM = {"type", "size", "fromto", "pos", "mass", "density", "shellinertia", "mesh", *ORIENTATIONS}
+          "frictionloss", "actuatorfrcrange", "actuatorfrclimited", "springdamper"}  # fmt: skip
+_GEOM = {"type", "size", "fromto", "pos", "mass", "density", "shellinertia", "mesh", "fitscale", *ORIENTATIONS}
 _BODY = {"pos", *ORIENTATIONS}
 _INERTIAL = {"pos", "mass", "diaginertia", "fullinertia", *ORIENTATIONS}
 _COMPILER_READ = {"angle", "eulerseq", "inertiafromgeom", "boundmass", "boundinertia", "autolimits",
                   "inertiagrouprange", "coordinate", "settotalmass", "meshdir", "assetdir", "texturedir",
-                  "strippath"}  # fmt: skip
+                  "strippath", "fitaabb"}  # fmt: skip
 _COMPILER_SWITCHES = {"balanceinertia", "fusestatic", "discardvisual", "alignfree"}  # fine while "false"
 _JOINT_TYPES = ("hinge", "slide", "ball", "free")
 # <option><flag>: switching these off changes what the articulation computes (gravity is read; contacts, limits and
@@ -64,6 +74,10 @@ class _Compiler:
     autolimits: bool = True
     inertiagrouprange: tuple[int, int] = (0, 5)
     settotalmass: float = -1.0
+    meshdir: str | None = None
+    assetdir: str | None = None
+    strippath: bool = False
+    fitaabb: bool = False
 
 
 @dataclass
@@ -73,6 +87,20 @@ class _Reader:
     compiler: _Compiler = field(default_factory=_Compiler)
     defaults: dict[str, dict[str, dict[str, str]]] = field(default_factory=lambda: {"main": {}})
     notes: dict[tuple[str, str], list[Node]] = field(default_factory=dict)
+    meshes: dict[str, tuple[MeshDescription, Node]] = field(default_factory=dict)
+    mesh_inertias: dict[str, MeshInertia] = field(default_factory=dict)
+
+    def mesh(self, node: Node, name: str) -> tuple[MeshDescription, MeshInertia]:
+        """The mesh a geom names and its inertia (computed once per mesh)."""
+        if name not in self.meshes:
+            raise node.error(f"mesh={name!r} names no <mesh> asset")
+        mesh, mesh_node = self.meshes[name]
+        if name not in self.mesh_inertias:
+            try:
+                self.mesh_inertias[name] = mesh_inertia(mesh.vertices, mesh.faces, mesh.inertia)
+            except ValueError as error:
+                raise mesh_node.error(f"mesh {name!r} ({mesh.source}): {error}") from None
+        return mesh, self.mesh_inertias[name]
 
     def note(self, node: Node, what: str, message: str) -> None:
         """Gather a warning; one is issued per element and attribute, at the end."""
@@ -157,6 +185,9 @@ def _read_compiler(reader: _Reader, node: Node) -> None:
         low, high = _numbers(node, a, "inertiagrouprange", 2)
         c.inertiagrouprange = (int(low), int(high))
     c.settotalmass = _number(node, a, "settotalmass", c.settotalmass)
+    c.meshdir, c.assetdir = a.get("meshdir", c.meshdir), a.get("assetdir", c.assetdir)
+    c.fitaabb = _keyword(node, a, "fitaabb", "true" if c.fitaabb else "false", ("true", "false")) == "true"
+    c.strippath = _keyword(node, a, "strippath", "true" if c.strippath else "false", ("true", "false")) == "true"
     if a.get("coordinate", "local") != "local":
         raise node.error("coordinate='global' was removed from MJCF (MuJoCo 2.3.3); use local coordinates")
     for name, value in a.items():
@@ -238,6 +269,7 @@ def _joint(reader: _Reader, node: Node, childclass: str, is_top: bool) -> JointD
         armature=_number(node, a, "armature", 0.0, nonnegative=True),
         frictionloss=_number(node, a, "frictionloss", 0.0, nonnegative=True),
         line=node.line,
+        springdamper=_springdamper(reader, node, a, kind),
     )
     if np.any(stiffness[1:] != 0.0):
         reader.note(node, "stiffness", "only the linear spring (its first number) is simulated by tumble")
@@ -250,17 +282,48 @@ def _joint(reader: _Reader, node: Node, childclass: str, is_top: bool) -> JointD
     return joint
 
 
+def _fitted(reader: _Reader, node: Node, kind: str, mesh: str, a: dict[str, str], pos, quat):
+    """A primitive geom that names a mesh is fitted to it (MuJoCo's rule): centred on the mesh's centre of mass,
+    along its principal axes, sized from the box of equal inertia, times ``fitscale``."""
+    _, inertia = reader.mesh(node, mesh)
+    axes, (x, y, z) = inertia.principal_frame()
+    radius = 0.5 * (x + y)
+    size = {"sphere": [(x + y + z) / 3.0, 0.0, 0.0], "capsule": [radius, max(0.0, z - 0.5 * radius), 0.0],
+            "cylinder": [radius, z, 0.0], "ellipsoid": [x, y, z], "box": [x, y, z]}[kind]  # fmt: skip
+    if reader.compiler.fitaabb:
+        reader.note(node, "fitaabb", "tumble fits primitives to the mesh's box of equal inertia, not its bounds")
+    size = np.array(size) * _number(node, a, "fitscale", 1.0)
+    return size, pos + quat_rotate(quat, inertia.com), quat_multiply(quat, axes)
+
+
+def _springdamper(reader: _Reader, node: Node, a: dict[str, str], kind: str) -> tuple[float, float] | None:
+    """``springdamper="timeconst dampratio"``: both positive, the spring and damper are sized from the joint's
+    effective mass (``read_mjcf`` does it, once the tree is known)."""
+    timeconst, dampratio = _numbers(node, a, "springdamper", 2, [0.0, 0.0])
+    if timeconst <= 0.0 or dampratio <= 0.0:
+        return None
+    if kind not in ("hinge", "slide"):
+        reader.note(node, "springdamper", f"a spring on a {kind} joint is not simulated by tumble; ignored")
+        return None
+    return float(timeconst), float(dampratio)
+
+
 def _geom(reader: _Reader, node: Node, childclass: str) -> tuple[GeomDescription, MassProperties | None]:
     """The geom and its mass properties in the body frame (``None``: no mass, or excluded by the group range)."""
     a = _resolved(reader, node, childclass)
     _check_known(reader, node, a, _GEOM)
     kind = _keyword(node, a, "type", "sphere", _GEOM_TYPES)
+    mesh = a.get("mesh")
+    if kind == "mesh" and mesh is None:
+        raise node.error("a mesh geom needs mesh=... naming a <mesh> asset")
     size = np.zeros(3)
     given = _numbers(node, a, "size", (1, 2, 3), [0.0])
     size[: given.size] = given
     pos = _numbers(node, a, "pos", 3, [0.0, 0.0, 0.0])
     quat = _frame_quat(reader, node, a)
     if "fromto" in a:
+        if "pos" in node.attrib:
+            raise node.error("give pos or fromto, not both")
         if kind not in ("capsule", "cylinder", "box", "ellipsoid"):
             raise node.error(f"fromto places a capsule, cylinder, box or ellipsoid, not a {kind}")
         ends = _numbers(node, a, "fromto", 6)
@@ -270,15 +333,26 @@ def _geom(reader: _Reader, node: Node, childclass: str) -> tuple[GeomDescription
             raise node.error(f"fromto={a['fromto']!r} has zero length")
         pos, quat = 0.5 * (ends[:3] + ends[3:]), quat_z_to(segment)
         size[1 if kind in ("capsule", "cylinder") else 2] = 0.5 * length
+    elif mesh is not None and kind in VOLUME_TYPES:
+        size, pos, quat = _fitted(reader, node, kind, mesh, a, pos, quat)
     group = int(_number(node, a, "group", 0.0))
     geom = GeomDescription(
         name=a.get("name"), type=kind, size=size, pos=pos, quat=quat, group=group,
         contype=int(_number(node, a, "contype", 1.0)), conaffinity=int(_number(node, a, "conaffinity", 1.0)),
-        friction=_numbers(node, a, "friction", (1, 2, 3), [1.0, 0.005, 0.0001]), line=node.line,
+        friction=_numbers(node, a, "friction", (1, 2, 3), [1.0, 0.005, 0.0001]), line=node.line, mesh=mesh,
     )  # fmt: skip
     low, high = reader.compiler.inertiagrouprange
     if not low <= group <= high:
         return geom, None
+    shell = _keyword(node, a, "shellinertia", "false", ("true", "false")) == "true"
+    if kind == "mesh":
+        if shell:
+            raise node.error("shellinertia on a mesh geom: a mesh's inertia is its <mesh inertia=...>")
+        _, inertia = reader.mesh(node, mesh)
+        mass = _geom_mass(node, a, inertia.measure)
+        if mass == 0.0:
+            return geom, None
+        return geom, inertia.mass_properties(mass).transformed(rotation=quat, translation=pos)
     if kind not in VOLUME_TYPES:
         if kind != "plane":
             reader.note(node, f"type={kind!r}", "its mass is not computed by tumble (yet); the geom adds none")
@@ -286,16 +360,25 @@ def _geom(reader: _Reader, node: Node, childclass: str) -> tuple[GeomDescription
     needed = {"sphere": 1, "capsule": 2, "cylinder": 2, "ellipsoid": 3, "box": 3}[kind]
     if np.any(size[:needed] <= 0.0):
         raise node.error(f"size={a.get('size')!r}: a {kind} needs {needed} positive sizes")
-    if a.get("shellinertia", "false") == "true":
-        reader.note(node, "shellinertia", "not supported by tumble; the geom's mass is that of a solid")
-    volume = geom_volume(kind, size)
-    if "mass" in a:
-        mass = _number(node, a, "mass", 0.0, nonnegative=True)
-    else:
-        mass = _number(node, a, "density", 1000.0, nonnegative=True) * volume
+    if shell and kind not in SHELL_TYPES:
+        reader.note(
+            node,
+            "shellinertia",
+            f"not computed by tumble for an {kind} (its area has no closed form); its mass is a solid's",
+        )
+        shell = False
+    mass = _geom_mass(node, a, geom_area(kind, size) if shell else geom_volume(kind, size))
     if mass == 0.0:
         return geom, None
-    return geom, geom_mass_properties(kind, size, mass).transformed(rotation=quat, translation=pos)
+    properties = (shell_mass_properties if shell else geom_mass_properties)(kind, size, mass)
+    return geom, properties.transformed(rotation=quat, translation=pos)
+
+
+def _geom_mass(node: Node, a: dict[str, str], measure: float) -> float:
+    """The geom's ``mass``, else ``density`` (1000 by default) times its volume (or area, for a shell)."""
+    if "mass" in a:
+        return _number(node, a, "mass", 0.0, nonnegative=True)
+    return _number(node, a, "density", 1000.0, nonnegative=True) * measure
 
 
 def _inertial(reader: _Reader, node: Node) -> MassProperties:
@@ -394,6 +477,24 @@ def _read_option_extras(reader: _Reader, node: Node) -> None:
                 reader.note(child, name, "switching this off is not supported by tumble; ignored")
 
 
+def _read_assets(reader: _Reader, node: Node, base: Path) -> None:
+    """The ``<mesh>`` assets of one ``<asset>``; textures, materials and the rest are for drawing."""
+    directory = base / (reader.compiler.meshdir or reader.compiler.assetdir or "")
+    for child in node.children:
+        if child.tag != "mesh":
+            if child.tag not in _SILENT:
+                reader.note(child, "element", "not supported by tumble; ignored")
+            continue
+        a = _resolved(reader, child, "main")
+        _check_known(reader, child, a, MESH_ATTRIBUTES | MESH_COSMETIC)
+        if np.any(_numbers(child, a, "refquat", 4, [1.0, 0.0, 0.0, 0.0]) != [1.0, 0.0, 0.0, 0.0]):
+            reader.note(child, "refquat", "not supported by tumble; ignored")
+        mesh = read_mesh(child, a, directory, reader.compiler.strippath)
+        if mesh.name in reader.meshes:
+            raise child.error(f"mesh {mesh.name!r} is defined twice (first on line {reader.meshes[mesh.name][1].line})")
+        reader.meshes[mesh.name] = (mesh, child)
+
+
 def _gravity_switched_off(node: Node) -> bool:
     """``<option><flag gravity="disable"/></option>``."""
     return any(child.tag == "flag" and child.attrib.get("gravity") == "disable" for child in node.children)
@@ -418,6 +519,9 @@ def describe(root: Node, base: Path) -> ModelDescription:
     for node in root.children:
         if node.tag == "default":
             _read_defaults(reader, node, None)
+    for node in root.children:  # assets before the bodies that use them, wherever the file writes them
+        if node.tag == "asset":
+            _read_assets(reader, node, base)
     gravity, timestep, integrator = np.array([0.0, 0.0, -9.81]), 0.002, "Euler"
     bodies: list[BodyDescription] = []
     world_geoms: list[GeomDescription] = []
@@ -440,7 +544,7 @@ def describe(root: Node, base: Path) -> ModelDescription:
                     world_geoms.append(_geom(reader, child, "main")[0])
                 elif child.tag not in _SILENT:
                     reader.note(child, "element", "not supported by tumble; ignored")
-        elif node.tag not in _SILENT and node.tag not in ("compiler", "default"):
+        elif node.tag not in _SILENT and node.tag not in ("compiler", "default", "asset"):
             reader.note(node, "element", "not loaded into an Articulation; ignored")
     if reader.compiler.settotalmass > 0:
         bodies = _scaled_to_total(bodies, reader.compiler.settotalmass)
@@ -448,4 +552,5 @@ def describe(root: Node, base: Path) -> ModelDescription:
     return ModelDescription(
         name=root.attrib.get("model", "MuJoCo Model"), source=root.file, bodies=tuple(bodies),
         world_geoms=tuple(world_geoms), gravity=gravity, timestep=timestep, integrator=integrator,
+        meshes={name: mesh for name, (mesh, _) in reader.meshes.items()},
     )  # fmt: skip
