@@ -4,8 +4,9 @@ Run from the repository root:
 
     python -m benchmarks.run --only model_files
 
-Models: Gymnasium's humanoid (13 bodies, 21 degrees of freedom, default classes, capsules from ``fromto``) and a
-generated chain of ``chain_links`` (100) capsule links hinged about y, one nested in the other. Rows: tumble's
+Models: Gymnasium's humanoid (13 bodies, 21 degrees of freedom, default classes, capsules from ``fromto``), a
+generated chain of ``chain_links`` (100) capsule links hinged about y, one nested in the other, and dm_control's dog
+(62 bodies, 85 degrees of freedom, 162 STL bone meshes weighed in MuJoCo's legacy mode, ``springdamper`` joints). Rows: tumble's
 ``read_mjcf`` (the XML into the plain description: parse, defaults, inertia from the geoms), ``from_mjcf`` (that and
 the articulation), ``from_mjcf`` and a first mass matrix (the articulation packed for its kernels; the kernels
 are loaded from Numba's cache before timing), and MuJoCo's ``MjModel.from_xml_path`` (parse and compile). Columns:
@@ -19,7 +20,7 @@ import time
 import warnings
 from pathlib import Path
 
-__all__ = ["bench_model_files", "chain_mjcf", "humanoid_path"]
+__all__ = ["bench_model_files", "chain_mjcf", "dog_path", "humanoid_path"]
 
 
 def humanoid_path() -> str | None:
@@ -29,6 +30,14 @@ def humanoid_path() -> str | None:
     except ImportError:
         return None
     return os.path.join(os.path.dirname(gymnasium.__file__), "envs", "mujoco", "assets", "humanoid.xml")
+
+
+def dog_path() -> str | None:
+    """dm_control's dog.xml, found without importing dm_control (which opens a window system), or None."""
+    import importlib.util
+
+    spec = importlib.util.find_spec("dm_control")
+    return None if spec is None else os.path.join(os.path.dirname(spec.origin), "suite", "dog.xml")
 
 
 def chain_mjcf(links: int) -> str:
@@ -60,7 +69,7 @@ def bench_model_files(chain_links: int = 100, repeat: int = 5) -> list[dict]:
         warnings.simplefilter("ignore", MJCFWarning)
         chain_file = Path(os.environ.get("TMPDIR", "/tmp")) / f"tumble_bench_chain_{chain_links}.xml"
         chain_file.write_text(chain_mjcf(chain_links))
-        models = [("humanoid", humanoid_path()), (f"chain of {chain_links}", str(chain_file))]
+        models = [("humanoid", humanoid_path()), (f"chain of {chain_links}", str(chain_file)), ("dog", dog_path())]
         from_mjcf(str(chain_file)).mass_matrix()  # load the articulation kernels before timing
         for name, path in models:
             if path is None:
