@@ -132,7 +132,8 @@ def test_vertices_without_faces_are_their_convex_hull_and_a_given_mass_is_kept()
 @pytest.mark.parametrize(
     "geom", ["type='sphere' size='0.3'", "type='box' size='0.1 0.2 0.3' pos='0.1 0.2 0' euler='0 30 60'",
              "type='capsule' size='0.1 0.2' pos='0.1 0.2 0' euler='0 30 60'",
-             "type='cylinder' fromto='0 0 0 0.2 0.1 0.4' size='0.05'", "type='box' size='0.1 0.2 0.3' mass='3'"],
+             "type='cylinder' fromto='0 0 0 0.2 0.1 0.4' size='0.05'", "type='box' size='0.1 0.2 0.3' mass='3'",
+             "type='ellipsoid' size='0.1 0.2 0.3' euler='10 20 30'", "type='ellipsoid' size='3 2 1' mass='7'"],
 )  # fmt: skip
 def test_shell_primitives_carry_their_mass_on_the_surface(geom):
     _compare(_one_body("", f"<geom {geom} shellinertia='true'/>"))

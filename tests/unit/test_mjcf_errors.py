@@ -200,9 +200,10 @@ def test_a_mesh_file_of_an_unknown_kind_or_unreadable_is_an_error_naming_it(tmp_
         read_mjcf(tmp_path / "model.xml")
 
 
-def test_a_mesh_used_by_no_geom_or_a_primitive_shell_loads_and_an_ellipsoid_shell_warns():
-    text = mesh_model(f"<mesh name='m' vertex='{TETRA}'/>", "type='ellipsoid' size='0.1 0.2 0.3' shellinertia='true'")
-    with pytest.warns(MJCFWarning, match=r"<geom> shellinertia \(line 1\): not computed by tumble for an ellipsoid"):
+def test_a_mesh_used_by_no_geom_loads_and_vertices_alone_are_their_hull():
+    text = mesh_model(f"<mesh name='m' vertex='{TETRA}'/>", "type='sphere' size='0.1'")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
         description = read_mjcf(text)
-    assert description.meshes["m"].faces.shape == (4, 3)  # the hull of four vertices
-    assert description.bodies[0].mass_properties.mass == pytest.approx(1000 * 4 / 3 * np.pi * 0.006)
+    assert description.meshes["m"].faces.shape == (4, 3)
+    assert description.bodies[0].mass_properties.mass == pytest.approx(1000 * 4 / 3 * np.pi * 0.001)

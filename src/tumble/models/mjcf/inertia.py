@@ -17,11 +17,14 @@ import numpy as np
 from ... import mass as _mass
 from ...mass import MassProperties
 
-__all__ = ["SHELL_TYPES", "VOLUME_TYPES", "bounded", "geom_area", "geom_mass_properties", "geom_volume",
+__all__ = ["VOLUME_TYPES", "bounded", "geom_area", "geom_mass_properties", "geom_volume",
            "shell_mass_properties"]  # fmt: skip
 
 VOLUME_TYPES = ("sphere", "capsule", "cylinder", "ellipsoid", "box")
-SHELL_TYPES = ("sphere", "capsule", "cylinder", "box")  # an ellipsoid's area has no closed form
+# An ellipsoid's area has no closed form: MuJoCo takes Knud Thomsen's approximation (within 1.061 %) and spreads the
+# mass as a layer of thickness 1 µm would (measured against MuJoCo 4's compiled masses and inertias).
+_THOMSEN_P = 1.6075
+_ELLIPSOID_LAYER = 1e-6  # [m]
 
 
 def geom_volume(kind: str, size: np.ndarray) -> float:
@@ -52,7 +55,7 @@ def geom_mass_properties(kind: str, size: np.ndarray, mass: float) -> MassProper
 
 
 def geom_area(kind: str, size: np.ndarray) -> float:
-    """The surface area of a primitive geom (not an ellipsoid)."""
+    """The surface area of a primitive geom (an ellipsoid's by Thomsen's approximation)."""
     r, h = size[0], size[1]
     if kind == "sphere":
         return 4.0 * np.pi * r**2
@@ -61,6 +64,9 @@ def geom_area(kind: str, size: np.ndarray) -> float:
     if kind == "cylinder":
         return 4.0 * np.pi * r * h + 2.0 * np.pi * r**2
     a, b, c = size
+    if kind == "ellipsoid":
+        p = _THOMSEN_P
+        return 4.0 * np.pi * (((a * b) ** p + (a * c) ** p + (b * c) ** p) / 3.0) ** (1.0 / p)
     return 8.0 * (a * b + b * c + c * a)  # box
 
 
@@ -71,6 +77,12 @@ def shell_mass_properties(kind: str, size: np.ndarray, mass: float) -> MassPrope
     r, h = size[0], size[1]
     if kind == "sphere":
         return MassProperties(mass, np.zeros(3), 2.0 / 3.0 * mass * r**2 * np.eye(3))
+    if kind == "ellipsoid":  # the moments per unit mass of a thin layer: a difference of two solids
+        inner, outer = (
+            geom_mass_properties(kind, size + t, geom_volume(kind, size + t)) for t in (0, _ELLIPSOID_LAYER)
+        )
+        layer = outer.mass - inner.mass
+        return MassProperties(mass, np.zeros(3), (outer.inertia - inner.inertia) * (mass / layer))
     if kind == "box":
         a, b, c = size
         side = np.array([a, b, c])

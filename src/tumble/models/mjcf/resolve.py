@@ -21,7 +21,6 @@ from ...rotation import quat_multiply, quat_rotate, quat_to_matrix
 from ..description import BodyDescription, GeomDescription, JointDescription, MeshDescription, ModelDescription
 from .frames import ORIENTATIONS, orientation, quat_z_to
 from .inertia import (
-    SHELL_TYPES,
     VOLUME_TYPES,
     bounded,
     geom_area,
@@ -360,13 +359,6 @@ def _geom(reader: _Reader, node: Node, childclass: str) -> tuple[GeomDescription
     needed = {"sphere": 1, "capsule": 2, "cylinder": 2, "ellipsoid": 3, "box": 3}[kind]
     if np.any(size[:needed] <= 0.0):
         raise node.error(f"size={a.get('size')!r}: a {kind} needs {needed} positive sizes")
-    if shell and kind not in SHELL_TYPES:
-        reader.note(
-            node,
-            "shellinertia",
-            f"not computed by tumble for an {kind} (its area has no closed form); its mass is a solid's",
-        )
-        shell = False
     mass = _geom_mass(node, a, geom_area(kind, size) if shell else geom_volume(kind, size))
     if mass == 0.0:
         return geom, None
