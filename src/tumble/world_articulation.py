@@ -28,6 +28,11 @@ def _check(art) -> None:
 
     if not isinstance(art, Articulation):
         raise TypeError(f"articulation must be a tumble.articulation.Articulation, got {art!r} ({type(art).__name__})")
+    if art.actuators:
+        raise ValueError(
+            f"the articulation has {len(art.actuators)} actuators: world joints have none; step the "
+            "articulation on its own, or apply their forces (WorldArticulation.apply_joint_forces)"
+        )
     for link in art.links:
         label = link.name or link.index
         if link.mass_properties is None or not link.mass_properties.mass > 0.0:

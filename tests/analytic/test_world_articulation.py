@@ -110,6 +110,10 @@ def test_bad_articulations_are_refused():
     damped.add_link(Revolute((0, 1, 0)), shape=ROD, mass=1.0, damping=0.5, name="elbow")
     with pytest.raises(ValueError, match="link 'elbow' has joint damping 0.5"):
         world.add_articulation(damped)
+    driven = Articulation()
+    driven.add_actuator(driven.add_link(Revolute((0, 1, 0)), shape=ROD, mass=1.0), gear=3.0)
+    with pytest.raises(ValueError, match="the articulation has 1 actuators: world joints have none"):
+        world.add_articulation(driven)
     assert world.bodies == [] and world.joints == []
 
 

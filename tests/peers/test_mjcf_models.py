@@ -133,13 +133,43 @@ def _load(name: str, mujocos_mesh_inertia: bool = False):
         _switch_off(tendon, "damping")
     spec.option.viscosity = spec.option.density = 0.0
     spec.option.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONSTRAINT  # no contacts, limits or equalities
-    spec.option.disableflags |= mujoco.mjtDisableBit.mjDSBL_ACTUATION  # servos push at zero control too
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # half_cheetah's deprecated settotalmass
         model = spec.compile()
+    driven = _driven(model)
+    for index in set(range(model.nu)) - set(driven):  # what tumble does not load pushes nothing in MuJoCo either
+        spec.actuators[index].gear = np.zeros(6)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        model = spec.compile()
+    assert len(art.actuators) == len(driven)
     if mujocos_mesh_inertia and any(_mesh_density(spec).values()):
         art = to_articulation(_with_mujocos_inertia(description, model))
     return art, description, model
+
+
+def _driven(model) -> list[int]:
+    """MuJoCo's actuators that tumble simulates: on a hinge or slide, fixed gain, affine bias or none, no activation
+    dynamics (in the model's order, as ``art.ctrl``)."""
+    joint = int(mujoco.mjtTrn.mjTRN_JOINT)
+    hinge, slide = int(mujoco.mjtJoint.mjJNT_HINGE), int(mujoco.mjtJoint.mjJNT_SLIDE)
+    affine = (int(mujoco.mjtBias.mjBIAS_NONE), int(mujoco.mjtBias.mjBIAS_AFFINE))
+    return [i for i in range(model.nu)
+            if model.actuator_trntype[i] == joint and model.jnt_type[model.actuator_trnid[i, 0]] in (hinge, slide)
+            and model.actuator_dyntype[i] == int(mujoco.mjtDyn.mjDYN_NONE)
+            and model.actuator_gaintype[i] == int(mujoco.mjtGain.mjGAIN_FIXED)
+            and model.actuator_biastype[i] in affine]  # fmt: skip
+
+
+def _random_controls(art, model, rng):
+    """Controls for both engines (``art.ctrl`` set), a quarter beyond their ranges (each engine clips them)."""
+    ctrl = rng.normal(size=model.nu)
+    for i in range(model.nu):
+        if model.actuator_ctrllimited[i]:
+            low, high = model.actuator_ctrlrange[i]
+            ctrl[i] = rng.uniform(low - 0.25 * (high - low), high + 0.25 * (high - low))
+    art.ctrl = ctrl[_driven(model)]
+    return ctrl
 
 
 NAMES = ["exercise", *GYMNASIUM, *SUITE]
@@ -200,6 +230,7 @@ def test_link_frames_mass_matrix_and_accelerations_equal_mujocos(name):
     for _ in range(3):
         q, qd = _random_state(model, rng)
         data.qpos[:], data.qvel[:] = q, qd
+        data.ctrl[:] = _random_controls(art, model, rng)
         mujoco.mj_forward(model, data)
         # A body's last link is the body frame moved to its last joint's pos (a welded body's: the body frame).
         positions, quats = art.link_poses(q)
@@ -215,20 +246,24 @@ def test_link_frames_mass_matrix_and_accelerations_equal_mujocos(name):
         mujoco.mj_fullM(model, data, full)
         scale = np.abs(full).max()
         np.testing.assert_allclose(art.mass_matrix(q), full, rtol=0, atol=1e-12 * scale)  # measured < 1e-15 relative
-        np.testing.assert_allclose(art.bias_forces(q, qd), data.qfrc_bias - data.qfrc_passive, rtol=0,
-                                   atol=1e-10 * max(1.0, np.abs(data.qfrc_bias).max()))  # fmt: skip
+        # tumble's bias holds the joints' own forces: damping, springs and the actuators' drive
+        np.testing.assert_allclose(art.bias_forces(q, qd), data.qfrc_bias - data.qfrc_passive - data.qfrc_actuator,
+                                   rtol=0, atol=1e-10 * max(1.0, np.abs(data.qfrc_bias).max()))  # fmt: skip
+        np.testing.assert_allclose(art.actuator_forces(q, qd), data.actuator_force[_driven(model)], rtol=1e-12,
+                                   atol=1e-12)  # fmt: skip
         acc = art.forward_dynamics(q, qd)
         np.testing.assert_allclose(acc, data.qacc, rtol=0, atol=1e-9 * max(1.0, np.abs(data.qacc).max()))
 
 
 def test_the_warnings_name_what_is_not_simulated_once_each_with_its_line():
     with pytest.warns(MJCFWarning) as record:
-        from_mjcf(os.path.join(ASSETS, "humanoid.xml"))
+        humanoid = from_mjcf(os.path.join(ASSETS, "humanoid.xml"))
     messages = [str(w.message) for w in record]
     assert len(messages) == len(set(messages))
     assert any("<joint> range (line " in m and "more)" in m for m in messages)
     assert any("<tendon> element (line " in m for m in messages)
-    assert any("<actuator> element (line " in m for m in messages)
+    assert not any("<motor>" in m or "<actuator>" in m for m in messages)  # its 17 motors are loaded
+    assert len(humanoid.actuators) == 17
     assert all("humanoid.xml" in m for m in messages)
 
 
@@ -263,6 +298,9 @@ def test_rk4_tracks_mujocos_rk4_for_two_seconds(name):
     q, qd = _random_state(model, rng)
     art.q, art.qd = q, 0.5 * qd
     data.qpos[:], data.qvel[:] = art.q, art.qd
+    # gentle controls: strong motors on a contact-free, unlimited model spin it until round-off grows chaotically
+    data.ctrl[:] = 0.02 * _random_controls(art, model, rng)
+    art.ctrl = data.ctrl[_driven(model)]
     dt = float(model.opt.timestep)
     steps = round(2.0 / dt)
     mujoco.mj_step(model, data, nstep=steps)  # (a reset after a bad acceleration would show as a difference)

@@ -301,3 +301,12 @@ def test_an_articulation_with_armature_or_springs_is_refused_by_name(passive):
     art.add_link(Revolute((0, 1, 0)), mass=1.0, shape_position=(0.0, 0.0, -1.0), name="arm", **passive)
     with pytest.raises(ValueError, match=r"link 0 \('arm'\) has joint armature or stiffness"):
         lagrange.from_articulation(art)
+
+
+def test_an_articulation_with_actuators_is_refused():
+    from tumble.articulation import Articulation, Revolute
+
+    art = Articulation()
+    art.add_actuator(art.add_link(Revolute((0, 1, 0)), mass=1.0, shape_position=(0.0, 0.0, -1.0)), gear=2.0)
+    with pytest.raises(ValueError, match=r"articulation has 1 actuators, which the symbolic derivation"):
+        lagrange.from_articulation(art)

@@ -80,15 +80,15 @@ def test_includes_are_found_beside_the_main_file_first_then_beside_the_including
 def test_each_unsupported_element_and_attribute_warns_once_with_its_first_line_and_count():
     text = model(
         '<body>\n<joint frictionloss="1" damping="0.1"/>\n<joint frictionloss="2" bogus="3"/><geom size="1"/></body>',
-        "<tendon/><actuator/>",
+        "<tendon/><sensor/>",
     )
     with pytest.warns(MJCFWarning) as record:
         from_mjcf(text)
     messages = sorted(str(w.message) for w in record)
     assert messages == [
-        "<string>: <actuator> element (line 1): not loaded into an Articulation; ignored",
         "<string>: <joint> bogus (line 3): not supported by tumble; ignored",
         "<string>: <joint> frictionloss (line 2 and 1 more): not simulated by tumble's Articulation (yet); ignored",
+        "<string>: <sensor> element (line 1): not loaded into an Articulation; ignored",
         "<string>: <tendon> element (line 1): not loaded into an Articulation; ignored",
     ]
 
@@ -207,3 +207,64 @@ def test_a_mesh_used_by_no_geom_loads_and_vertices_alone_are_their_hull():
         description = read_mjcf(text)
     assert description.meshes["m"].faces.shape == (4, 3)
     assert description.bodies[0].mass_properties.mass == pytest.approx(1000 * 4 / 3 * np.pi * 0.001)
+
+
+ARM = """<mujoco><compiler autolimits="{autolimits}"/>
+  <default><motor gear="50" ctrlrange="-1 1"/><default class="servo"><position kp="20" kv="2"/></default></default>
+  <worldbody><body><joint name="shoulder" axis="0 1 0"/><geom size="0.1"/>
+    <body pos="0 0 -0.5"><joint name="twist" type="ball"/><joint name="slide" type="slide" pos="0 0 0.1"/>
+      <geom size="0.1"/></body></body></worldbody>
+  <actuator>{actuators}</actuator></mujoco>"""
+
+
+def arm(actuators: str, autolimits: str = "true") -> str:
+    return ARM.format(actuators=actuators, autolimits=autolimits)
+
+
+def test_motors_servos_and_general_actuators_read_with_their_default_classes():
+    actuators = ('<motor name="m" joint="shoulder"/>'
+                 '<position class="servo" joint="slide" gear="2" ctrlrange="-0.3 0.3"/>'
+                 '<velocity joint="shoulder" kv="4" ctrllimited="false"/>'
+                 '<general joint="slide" gainprm="3" biastype="affine" biasprm="0.1 -2 -0.5"/>')  # fmt: skip
+    description = read_mjcf(arm(actuators))
+    motor, servo, speed, general = description.actuators
+    assert (motor.name, motor.kind, motor.joint, motor.gear, motor.gain, motor.ctrl_range) == (
+        "m", "motor", "shoulder", 50.0, 1.0, (-1.0, 1.0))  # fmt: skip
+    assert (servo.gear, servo.gain, servo.bias.tolist(), servo.ctrl_range) == (2.0, 20.0, [0, -20, -2], (-0.3, 0.3))
+    assert (speed.gain, speed.bias.tolist(), speed.ctrl_range) == (4.0, [0, 0, -4], None)
+    assert (general.gain, general.bias.tolist(), general.gear) == (3.0, [0.1, -2, -0.5], 50.0)
+    art = from_mjcf(arm('<motor joint="shoulder"/><position class="servo" joint="slide"/>'))
+    assert [a.link for a in art.actuators] == [0, 2]  # the shoulder's link; the slide's, after the ball's
+    assert art.actuators[1].bias.tolist() == [0.0, -20.0, -2.0]
+
+
+@pytest.mark.parametrize(
+    ("actuators", "match"),
+    [
+        ('<motor tendon="t"/>', r"<motor> tendon \(line 6\): tumble drives joints only; this actuator is not loaded"),
+        ('<motor joint="twist"/>', r"<motor> joint .*tumble drives hinges and slides, not a ball; not loaded"),
+        ('<general joint="shoulder" dyntype="filter"/>', r"<general> element .*dyntype='filter': activation dynamics"),
+        ('<muscle joint="shoulder"/>', r"<muscle> element .*this actuator is not simulated by tumble; not loaded"),
+        ('<motor joint="shoulder" forcerange="-1 1"/>', r"<motor> forcerange .*not clipped by tumble"),
+    ],
+)  # fmt: skip
+def test_actuators_tumble_does_not_simulate_are_named_and_not_loaded(actuators, match):
+    with pytest.warns(MJCFWarning, match=match):
+        description = read_mjcf(arm(actuators))
+    assert len(description.actuators) == (1 if "forcerange" in actuators else 0)
+
+
+@pytest.mark.parametrize(
+    ("actuators", "autolimits", "match"),
+    [
+        ('<motor joint="elbow"/>', "true", r"line 6, <motor>: joint='elbow' names no joint"),
+        ('<motor joint="shoulder" ctrlrange="1 -1"/>', "true", r"ctrlrange='1 -1' must have its lower bound below"),
+        ('<velocity joint="shoulder" ctrlrange="-1 1"/>', "false", r"ctrlrange without ctrllimited=\.\.\. needs "
+         "compiler autolimits"),
+        ('<position joint="shoulder" kp="-1"/>', "true", r"<position>: kp='-1' must be >= 0"),
+        ('<motor joint="shoulder" class="nope"/>', "true", r"<motor>: class='nope' names no default class"),
+    ],
+)  # fmt: skip
+def test_a_bad_actuator_gives_an_error_naming_it(actuators, autolimits, match):
+    with pytest.raises(MJCFError, match=match):
+        quiet(arm(actuators, autolimits))

@@ -14,6 +14,7 @@ Inverse dynamics by RNEA, the mass matrix by CRBA, forward dynamics by its spars
 
 from __future__ import annotations
 
+from .actuators import Actuator
 from .articulation import Articulation, ArticulationTrajectory, Link
 from .joints import Ball, Fixed, Free, Joint, JointType, Prismatic, Revolute
 from .loops import LoopClosure
@@ -22,8 +23,9 @@ from .loops import LoopClosure
 def from_mjcf(path_or_xml) -> Articulation:
     """The articulation of an MJCF model (a file path, or XML text starting with ``<``): its bodies, joints and
     mass properties in generalised coordinates, ``q``/``qd`` in MuJoCo's ``qpos``/``qvel`` order and conventions,
-    starting at ``qpos0``; no contacts. What tumble does not simulate is named in one warning per element and
-    attribute (:class:`tumble.models.mjcf.MJCFWarning`); a file that cannot be read raises
+    starting at ``qpos0``; its actuators on hinges and slides driven by ``ctrl`` in MuJoCo's order; no contacts.
+    What tumble does not simulate is named in one warning per element and attribute
+    (:class:`tumble.models.mjcf.MJCFWarning`); a file that cannot be read raises
     :class:`tumble.models.mjcf.MJCFError` naming the file, element and line. See docs/model_files.md."""
     from ..models.build import to_articulation
     from ..models.mjcf import read_mjcf
@@ -32,6 +34,7 @@ def from_mjcf(path_or_xml) -> Articulation:
 
 
 __all__ = [
+    "Actuator",
     "Articulation",
     "ArticulationTrajectory",
     "Ball",

@@ -22,7 +22,7 @@ from __future__ import annotations
 
 from .._jit import inline
 from ..math3d import add, scale
-from .dynamics import SINGULAR_RTOL, passive_force
+from .dynamics import SINGULAR_RTOL, joint_force
 from .model import (
     ACC,
     ARMATURE,
@@ -159,7 +159,7 @@ def aba(link_ints, world, dof_params, link_work, dof_motion, dof_u, dof_pivot, q
             if not pivot > SINGULAR_RTOL * largest:
                 return k
             spring_q = q[link_ints[i, Q_START] + k - first]
-            u = tau[k] - passive_force(dof_params, k, spring_q, qd[k]) - dot6(s, bias)
+            u = tau[k] - joint_force(dof_params, k, spring_q, qd[k]) - dot6(s, bias)
             put6(dof_u, k, 0, u_vec)
             dof_pivot[k] = pivot
             qdd[k] = u

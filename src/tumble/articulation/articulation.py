@@ -29,6 +29,7 @@ from ..errors import SimulationError
 from ..mass import MassProperties
 from ..rotation import quat_from_rotvec, quat_multiply, quat_to_matrix
 from ..shapes import Shape
+from .actuators import Actuator, actuator_forces, drive_columns
 from .integrators import EULER, NOT_FINITE, RK4, SYMPLECTIC
 from .joints import Ball, Free, Joint, Prismatic, Revolute
 from .kernels import FORWARD, INVERSE, KINEMATICS, MASS_MATRIX, PROJECT, SIMULATE, articulation_kernel
@@ -36,6 +37,7 @@ from .loops import LoopClosure
 from .model import (
     DOF_PARENT,
     DOF_TIP,
+    DRIVE,
     INERTIA_WORLD,
     LOOP_ERROR,
     POS,
@@ -49,7 +51,7 @@ from .model import (
     work_views,
 )
 
-__all__ = ["Articulation", "ArticulationTrajectory", "Link"]
+__all__ = ["Actuator", "Articulation", "ArticulationTrajectory", "Link"]
 
 INTEGRATORS = {"euler": EULER, "symplectic": SYMPLECTIC, "rk4": RK4}
 LOOP_KINDS = ("point",)
@@ -168,6 +170,8 @@ class Articulation:
         self._time = 0.0
         self._step_count = 0
         self._compiled: _Compiled | None = None
+        self._actuators: list[Actuator] = []
+        self._ctrl = np.zeros(0)
 
     # --- building ------------------------------------------------------------------------------------
 
@@ -254,6 +258,67 @@ class Articulation:
         self._loops.append(loop)
         self._compiled = None
         return loop.index
+
+    def add_actuator(self, link, *, gear=1.0, gain=1.0, bias=(0.0, 0.0, 0.0), ctrl_range=None, name=None) -> int:
+        """Drive ``link``'s Revolute or Prismatic joint from ``ctrl``; returns the actuator's index in ``ctrl``.
+
+        The actuator pulls along its length ``l = gear · q`` with ``f = gain · c + bias[0] + bias[1] l + bias[2] l̇``
+        (``c`` the control, clipped to ``ctrl_range``) and pushes the joint with ``gear · f``: a motor is the
+        default (``gear · ctrl``), a position servo ``gain=kp, bias=(0, -kp, -kv)``, a velocity servo ``gain=kv,
+        bias=(0, 0, -kv)`` (MuJoCo's actuators on a joint; see ``actuators.py``). Its control starts at 0.
+
+        Args:
+            link: a link index; gear, gain: finite; bias: (3,); ctrl_range: ``(low, high)`` with low <= high, or
+                ``None``; name: optional unique label.
+        """
+        link = self._check_link("link", link)
+        joint = self._links[link].joint
+        if not isinstance(joint, (Revolute, Prismatic)):
+            raise ValueError(f"link {link} has a {joint!r} joint: an actuator drives a Revolute or Prismatic one")
+        gear, gain = as_float("gear", gear), as_float("gain", gain)
+        bias = _readonly(as_array("bias", bias, (3,), batch=False))
+        if ctrl_range is not None:
+            low, high = (float(v) for v in as_array("ctrl_range", ctrl_range, (2,), batch=False))
+            if not low <= high:
+                raise ValueError(f"ctrl_range must be (low, high) with low <= high, got {_show(ctrl_range)}")
+            ctrl_range = (low, high)
+        if name is not None and not isinstance(name, str):
+            raise TypeError(f"name must be a string or None, got {_show(name)}")
+        if name is not None and any(a.name == name for a in self._actuators):
+            raise ValueError(f"name must be unique among the actuators, got {name!r}")
+        self._actuators.append(Actuator(len(self._actuators), name, link, gear, gain, bias, ctrl_range))
+        self._ctrl = np.append(self._ctrl, 0.0)
+        self._compiled = None
+        return len(self._actuators) - 1
+
+    @property
+    def actuators(self) -> tuple[Actuator, ...]:
+        return tuple(self._actuators)
+
+    @property
+    def ctrl(self) -> np.ndarray:
+        """(number of actuators,) the controls (a copy), held until set again; clipped to each actuator's
+        ``ctrl_range`` where it acts, kept as given here."""
+        return self._ctrl.copy()
+
+    @ctrl.setter
+    def ctrl(self, value) -> None:
+        self._ctrl = self._check_vector("ctrl", value, len(self._actuators))
+        if self._compiled is not None:
+            self._compiled.views()[0].dof_params[:, DRIVE:] = self._drives()
+
+    def actuator_forces(self, q=None, qd=None) -> np.ndarray:
+        """Each actuator's force along its length at the state (default the current one), before its gear:
+        MuJoCo's ``actuator_force``."""
+        q = self._q if q is None else self._check_q("q", q)
+        qd = self._qd if qd is None else self._check_vector("qd", qd, self.nv)
+        links = [self._links[a.link] for a in self._actuators]
+        return actuator_forces(self._actuators, [link.v_slice.start for link in links],
+                               [link.q_slice.start for link in links], self._ctrl, q, qd)  # fmt: skip
+
+    def _drives(self) -> np.ndarray:
+        dofs = [self._links[a.link].v_slice.start for a in self._actuators]
+        return drive_columns(self._actuators, dofs, self._ctrl, self.nv)
 
     # --- description -----------------------------------------------------------------------------------
 
@@ -527,7 +592,7 @@ class Articulation:
     def _compile(self) -> _Compiled:
         if self._compiled is None:
             ints, reals = pack_model(self._links, self._loops, self._gravity, self._base_position,
-                                     self._base_orientation)  # fmt: skip
+                                     self._base_orientation, self._drives())  # fmt: skip
             n, nq, nv, nl = counts(ints)
             self._compiled = _Compiled(
                 ints, reals, np.zeros(work_size(n, nq, nv, nl)), np.zeros(nv), np.zeros((n, 6)), np.zeros(nv),

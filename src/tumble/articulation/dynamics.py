@@ -9,10 +9,10 @@
 * LTDL (§6.5): ``H = Lᵀ D L`` following ``dof_parent``, so branches of the tree cost nothing; forward dynamics
   is ``H q̈ = τ - C(q, q̇)`` solved with it (§6.1; ``integrators.accelerations``).
 
-The joints' passive forces are part of the bias: ``C = RNEA(q, q̇, 0) + D q̇ + K (q - q_ref)`` with ``D`` and ``K``
-the diagonals of the damping and stiffness in ``dof_params``, so inverse dynamics returns the actuator force that
-produces ``q̈`` against them too. A joint's armature (the reflected inertia of a motor's rotor, as in MuJoCo) adds
-to ``H``'s diagonal.
+The joints' own forces are part of the bias: ``C = RNEA(q, q̇, 0) + D q̇ + K (q - q_ref) - a(q, q̇)`` with ``D``
+and ``K`` the diagonals of the damping and stiffness in ``dof_params`` and ``a`` the drive of the actuators at their
+present controls, so inverse dynamics returns the joint force that produces ``q̈`` beside them. A joint's armature
+(the reflected inertia of a motor's rotor, as in MuJoCo) adds to ``H``'s diagonal.
 """
 
 from __future__ import annotations
@@ -26,6 +26,9 @@ from .model import (
     DAMPING,
     DOF_LINK,
     DOF_PARENT,
+    DRIVE,
+    DRIVE_Q,
+    DRIVE_QD,
     FORCE,
     GRAVITY,
     INERTIA_WORLD,
@@ -84,13 +87,14 @@ def joint_energies(link_ints, dof_params, q, qd):
 
 
 @inline
-def passive_force(dof_params, k, q_value, qd_value):
-    """The joint's force against degree of freedom ``k``: ``damping q̇ + stiffness (q - springref)`` (a spring only
-    on a hinge or slide, whose coordinate ``q_value`` is its own; elsewhere the stiffness is zero)."""
+def joint_force(dof_params, k, q_value, qd_value):
+    """The joint's own force against degree of freedom ``k``: ``damping q̇ + stiffness (q - springref)`` less its
+    actuators' drive ``DRIVE + DRIVE_Q q + DRIVE_QD q̇`` (springs and actuators only on a hinge or slide, whose
+    coordinate ``q_value`` is its own; elsewhere those columns are zero)."""
     force = dof_params[k, DAMPING] * qd_value
     if dof_params[k, STIFFNESS] != 0.0:
         force += dof_params[k, STIFFNESS] * (q_value - dof_params[k, SPRINGREF])
-    return force
+    return force - (dof_params[k, DRIVE] + dof_params[k, DRIVE_Q] * q_value + dof_params[k, DRIVE_QD] * qd_value)
 
 
 @inline
@@ -127,7 +131,7 @@ def rnea(link_ints, world, dof_params, link_work, dof_motion, q, qd, qdd, extern
         first = link_ints[i, V_START]
         for k in range(first, _dof_stop(link_ints, i, nv)):
             spring_q = q[link_ints[i, Q_START] + k - first]
-            out[k] = (dot6(get6(dof_motion, k, 0), force) + passive_force(dof_params, k, spring_q, qd[k])
+            out[k] = (dot6(get6(dof_motion, k, 0), force) + joint_force(dof_params, k, spring_q, qd[k])
                       + dof_params[k, ARMATURE] * qdd[k])  # fmt: skip
         parent = link_ints[i, PARENT]
         if parent >= 0:

@@ -46,9 +46,10 @@ POINT_A, POINT_B = 0, 3
 POS, QUAT, VEL, VEL_PRODUCT, ACC, FORCE, INERTIA_WORLD, COMPOSITE = 0, 3, 7, 13, 19, 25, 31, 41
 ART_INERTIA, ART_BIAS, ART_STORED = 51, 72, 78
 LINK_WORK_WIDTH = 79
-# dof_params columns: the joint's passive terms on each degree of freedom
-DAMPING, ARMATURE, STIFFNESS, SPRINGREF = 0, 1, 2, 3
-DOF_PARAM_WIDTH = 4
+# dof_params columns: the joint's passive terms on each degree of freedom, and its actuators' drive
+# ``DRIVE + DRIVE_Q q + DRIVE_QD q̇`` (the controls folded into DRIVE)
+DAMPING, ARMATURE, STIFFNESS, SPRINGREF, DRIVE, DRIVE_Q, DRIVE_QD = 0, 1, 2, 3, 4, 5, 6
+DOF_PARAM_WIDTH = 7
 # dof_work rows
 BIAS, RHS, QDD, DIAG, QD_START, QD_STAGE, QDD_SUM, QD_SUM, CHART = 0, 1, 2, 3, 4, 5, 6, 7, 8
 DOF_WORK_ROWS = 9
@@ -70,9 +71,10 @@ class Model(NamedTuple):
             (4): the link frame in the parent frame at zero displacement; ``MASS`` [kg]; ``COM`` (3) [m] and
             ``INERTIA`` (9) [kg m²] about it, link frame.
         dof_ints: (nv, 2) int64: ``DOF_PARENT`` (-1: none) and ``DOF_LINK``.
-        dof_params: (nv, 4): ``DAMPING`` [N m s/rad or N s/m], ``ARMATURE`` (a rotor's inertia added to the
+        dof_params: (nv, 7): ``DAMPING`` [N m s/rad or N s/m], ``ARMATURE`` (a rotor's inertia added to the
             degree of freedom's own, [kg m²] or [kg]), ``STIFFNESS`` [N m/rad or N/m] and ``SPRINGREF`` (the
-            spring's rest coordinate) of the joint: the force ``-damping q̇ - stiffness (q - springref)``.
+            spring's rest coordinate) of the joint: the force ``-damping q̇ - stiffness (q - springref)``; and
+            the drive of its actuators at their present controls, ``DRIVE + DRIVE_Q q + DRIVE_QD q̇``.
         world: (10,): ``GRAVITY`` (3) [m/s²], ``BASE_POS`` (3) [m], ``BASE_QUAT`` (4).
         loop_ints: (L, 2) int64: ``LINK_A``, ``LINK_B`` (-1: the world).
         loop_reals: (L, 6): ``POINT_A``, ``POINT_B`` [m], in the frames of link a and link b (or the world).
@@ -202,13 +204,14 @@ def counts(ints: np.ndarray) -> tuple[int, int, int, int]:
     return int(ints[0]), int(ints[1]), int(ints[2]), int(ints[3])
 
 
-def pack_model(links, loops, gravity, base_pos, base_quat) -> tuple[np.ndarray, np.ndarray]:
+def pack_model(links, loops, gravity, base_pos, base_quat, drives=None) -> tuple[np.ndarray, np.ndarray]:
     """Build ``(ints, reals)`` from link and loop descriptions.
 
     Args:
         links: sequence of :class:`~tumble.articulation.articulation.Link` (parents before children).
         loops: sequence of :class:`~tumble.articulation.loops.LoopClosure`.
         gravity, base_pos: (3,); base_quat: (4,), unit.
+        drives: (nv, 3) the actuators' ``DRIVE``, ``DRIVE_Q``, ``DRIVE_QD`` columns (default none).
     """
     n, nl = len(links), len(loops)
     nq = sum(link.joint.nq for link in links)
@@ -224,7 +227,7 @@ def pack_model(links, loops, gravity, base_pos, base_quat) -> tuple[np.ndarray, 
         above = -1 if link.parent is None else m.link_ints[link.parent, DOF_TIP]
         for k in range(link.v_slice.start, link.v_slice.stop):
             m.dof_ints[k] = (above, i)
-            m.dof_params[k] = (link.damping, link.armature, link.stiffness, link.springref)
+            m.dof_params[k, :DRIVE] = (link.damping, link.armature, link.stiffness, link.springref)
             above = k
         m.link_ints[i] = (-1 if link.parent is None else link.parent, int(joint.type), link.q_slice.start,
                           link.v_slice.start, above)  # fmt: skip
@@ -236,6 +239,8 @@ def pack_model(links, loops, gravity, base_pos, base_quat) -> tuple[np.ndarray, 
             row[MASS] = link.mass_properties.mass
             row[COM : COM + 3] = link.mass_properties.com
             row[INERTIA : INERTIA + 9] = link.mass_properties.inertia.ravel()
+    if drives is not None:
+        m.dof_params[:, DRIVE:] = drives
     for k, loop in enumerate(loops):
         m.loop_ints[k] = (loop.link_a, -1 if loop.link_b is None else loop.link_b)
         m.loop_reals[k, POINT_A : POINT_A + 3] = loop.point_a

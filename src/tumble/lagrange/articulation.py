@@ -91,6 +91,9 @@ def from_articulation(articulation, gravity=None, *, parameters=None) -> System:
         if getattr(link, "armature", 0.0) != 0.0 or getattr(link, "stiffness", 0.0) != 0.0:
             raise ValueError(f"link {_label(link)} has joint armature or stiffness, which the symbolic derivation "
                              "does not model yet")  # fmt: skip
+    if getattr(articulation, "actuators", ()):
+        raise ValueError(f"articulation has {len(articulation.actuators)} actuators, which the symbolic derivation "
+                         "does not model yet: give their forces as generalised forces instead")  # fmt: skip
     damping = [-float(getattr(links[index], "damping", 0.0)) * q.diff() for index, q in coordinates.items()]
     g = articulation.gravity if gravity is None else gravity
     forces = damping if any(d != 0 for d in damping) else None

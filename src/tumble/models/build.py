@@ -6,7 +6,8 @@ properties; a body without joints is welded to its parent (``Fixed``). tumble's 
 joint at ``pos`` in its body puts the link's origin there; the body's mass properties and its children are placed
 relative to it. MuJoCo measures a hinge or slide from its ``ref`` (the coordinate at the model's pose), so the link
 frame is turned (moved) back by ``ref``: ``q`` then equals MuJoCo's ``qpos`` and ``qd`` its ``qvel``, entry by entry,
-and the articulation starts at MuJoCo's ``qpos0``.
+and the articulation starts at MuJoCo's ``qpos0``. The model's actuators drive the links of their joints, ``art.ctrl``
+in the model's order.
 """
 
 from __future__ import annotations
@@ -43,6 +44,7 @@ def to_articulation(model: ModelDescription) -> Articulation:
     art = Articulation(gravity=model.gravity, name=model.name)
     last_link: dict[int, tuple[int | None, np.ndarray]] = {-1: (None, np.zeros(3))}
     initial: list[tuple[int, float]] = []
+    joint_links: dict[str, int] = {}
     for index, body in enumerate(model.bodies):
         parent, parent_anchor = last_link[body.parent]
         joints = body.joints or (_WELD,)
@@ -64,9 +66,14 @@ def to_articulation(model: ModelDescription) -> Articulation:
                                   springref=joint.springref)  # fmt: skip
             if joint.type in ("hinge", "slide") and joint.ref != 0.0:
                 initial.append((parent, joint.ref))
+            if joint.name is not None:
+                joint_links[joint.name] = parent
         last_link[index] = (parent, joints[-1].pos)
     for link, ref in initial:
         art.set_joint(link, q=ref)
+    for actuator in model.actuators:
+        art.add_actuator(joint_links[actuator.joint], gear=actuator.gear, gain=actuator.gain, bias=actuator.bias,
+                         ctrl_range=actuator.ctrl_range, name=actuator.name)  # fmt: skip
     return art
 
 

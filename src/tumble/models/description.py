@@ -14,7 +14,8 @@ import numpy as np
 
 from ..mass import MassProperties
 
-__all__ = ["BodyDescription", "GeomDescription", "JointDescription", "MeshDescription", "ModelDescription"]
+__all__ = ["ActuatorDescription", "BodyDescription", "GeomDescription", "JointDescription", "MeshDescription",
+           "ModelDescription"]  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -82,6 +83,21 @@ class BodyDescription:
 
 
 @dataclass(frozen=True)
+class ActuatorDescription:
+    """An actuator on a hinge or slide joint: the force ``gain · ctrl + bias · (1, l, l̇)`` along its length
+    ``l = gear · q``, the control clipped to ``ctrl_range`` (see ``tumble.articulation.actuators``)."""
+
+    name: str | None
+    kind: str  # the element it was written as: "motor", "position", "velocity" or "general"
+    joint: str
+    gear: float
+    gain: float
+    bias: np.ndarray  # (3,)
+    ctrl_range: tuple[float, float] | None
+    line: int
+
+
+@dataclass(frozen=True)
 class ModelDescription:
     """A whole model: the bodies (without the world), the world's own geoms, and the simulation options."""
 
@@ -93,6 +109,7 @@ class ModelDescription:
     timestep: float = 0.002
     integrator: str = "Euler"
     meshes: dict[str, MeshDescription] = field(default_factory=dict)
+    actuators: tuple[ActuatorDescription, ...] = ()  # those tumble simulates, in the file's order
 
     def body_index(self, name: str) -> int:
         for index, body in enumerate(self.bodies):

@@ -18,7 +18,19 @@ import numpy as np
 
 from ...mass import MassProperties
 from ...rotation import quat_multiply, quat_rotate, quat_to_matrix
-from ..description import BodyDescription, GeomDescription, JointDescription, MeshDescription, ModelDescription
+from ..description import (
+    ActuatorDescription,
+    BodyDescription,
+    GeomDescription,
+    JointDescription,
+    MeshDescription,
+    ModelDescription,
+)
+from .actuators import ACTUATOR_TAGS, describe_actuator
+from .attributes import flag as _flag
+from .attributes import keyword as _keyword
+from .attributes import number as _number
+from .attributes import numbers as _numbers
 from .frames import ORIENTATIONS, orientation, quat_z_to
 from .inertia import (
     VOLUME_TYPES,
@@ -112,39 +124,6 @@ class _Reader:
 
 
 # --- attributes --------------------------------------------------------------------------------------
-
-
-def _numbers(node: Node, attrib: dict[str, str], name: str, count: int | tuple[int, ...], default=None):
-    text = attrib.get(name)
-    if text is None:
-        return None if default is None else np.array(default, dtype=float)
-    try:
-        values = np.array([float(word) for word in text.split()], dtype=float)
-    except ValueError:
-        raise node.error(f"{name}={text!r} is not a list of numbers") from None
-    counts = (count,) if isinstance(count, int) else count
-    if values.size not in counts or not np.all(np.isfinite(values)):
-        wanted = " or ".join(str(c) for c in counts)
-        raise node.error(f"{name}={text!r} must be {wanted} finite numbers")
-    return values
-
-
-def _number(node: Node, attrib: dict[str, str], name: str, default: float, nonnegative: bool = False) -> float:
-    value = float(_numbers(node, attrib, name, 1, [default])[0])
-    if nonnegative and value < 0:
-        raise node.error(f"{name}={attrib[name]!r} must be >= 0")
-    return value
-
-
-def _keyword(node: Node, attrib: dict[str, str], name: str, default: str, allowed: tuple[str, ...]) -> str:
-    value = attrib.get(name, default)
-    if value not in allowed:
-        raise node.error(f"{name}={value!r} must be one of {', '.join(allowed)}")
-    return value
-
-
-def _flag(node: Node, attrib: dict[str, str], name: str, default: str) -> str:
-    return _keyword(node, attrib, name, default, ("true", "false", "auto"))
 
 
 def _frame_quat(reader: _Reader, node: Node, attrib: dict[str, str]) -> np.ndarray:
@@ -487,6 +466,21 @@ def _read_assets(reader: _Reader, node: Node, base: Path) -> None:
         reader.meshes[mesh.name] = (mesh, child)
 
 
+def _read_actuators(reader: _Reader, root: Node, bodies: list[BodyDescription]) -> tuple[ActuatorDescription, ...]:
+    """The actuators tumble simulates, from every ``<actuator>`` section, once the joints are known."""
+    joint_types = {j.name: j.type for body in bodies for j in body.joints if j.name is not None}
+    found = []
+    for node in (child for section in root.children if section.tag == "actuator" for child in section.children):
+        name = node.attrib.get("class", "main")
+        if name not in reader.defaults:
+            raise node.error(f"class={name!r} names no default class")
+        defaults = reader.defaults[name]
+        a = {key: value for tag in ACTUATOR_TAGS for key, value in defaults.get(tag, {}).items()} | node.attrib
+        actuator = describe_actuator(node, a, joint_types, reader.compiler.autolimits, reader.note)
+        found += [actuator] if actuator is not None else []
+    return tuple(found)
+
+
 def _gravity_switched_off(node: Node) -> bool:
     """``<option><flag gravity="disable"/></option>``."""
     return any(child.tag == "flag" and child.attrib.get("gravity") == "disable" for child in node.children)
@@ -536,13 +530,14 @@ def describe(root: Node, base: Path) -> ModelDescription:
                     world_geoms.append(_geom(reader, child, "main")[0])
                 elif child.tag not in _SILENT:
                     reader.note(child, "element", "not supported by tumble; ignored")
-        elif node.tag not in _SILENT and node.tag not in ("compiler", "default", "asset"):
+        elif node.tag not in _SILENT and node.tag not in ("compiler", "default", "asset", "actuator"):
             reader.note(node, "element", "not loaded into an Articulation; ignored")
+    actuators = _read_actuators(reader, root, bodies)
     if reader.compiler.settotalmass > 0:
         bodies = _scaled_to_total(bodies, reader.compiler.settotalmass)
     reader.warn_all(root.file)
     return ModelDescription(
         name=root.attrib.get("model", "MuJoCo Model"), source=root.file, bodies=tuple(bodies),
         world_geoms=tuple(world_geoms), gravity=gravity, timestep=timestep, integrator=integrator,
-        meshes={name: mesh for name, (mesh, _) in reader.meshes.items()},
+        meshes={name: mesh for name, (mesh, _) in reader.meshes.items()}, actuators=actuators,
     )  # fmt: skip

@@ -1,0 +1,44 @@
+"""Reading MJCF attribute values: lists of numbers, numbers, keywords and ``true``/``false``/``auto`` flags, each
+refused with an :class:`~.xml.MJCFError` naming the element, its line and the text when it cannot be read."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .xml import Node
+
+__all__ = ["flag", "keyword", "number", "numbers"]
+
+
+def numbers(node: Node, attrib: dict[str, str], name: str, count: int | tuple[int, ...], default=None):
+    """The numbers of ``attrib[name]`` (``count`` of them, or one of the counts), else ``default`` (or None)."""
+    text = attrib.get(name)
+    if text is None:
+        return None if default is None else np.array(default, dtype=float)
+    try:
+        values = np.array([float(word) for word in text.split()], dtype=float)
+    except ValueError:
+        raise node.error(f"{name}={text!r} is not a list of numbers") from None
+    counts = (count,) if isinstance(count, int) else count
+    if values.size not in counts or not np.all(np.isfinite(values)):
+        wanted = " or ".join(str(c) for c in counts)
+        raise node.error(f"{name}={text!r} must be {wanted} finite numbers")
+    return values
+
+
+def number(node: Node, attrib: dict[str, str], name: str, default: float, nonnegative: bool = False) -> float:
+    value = float(numbers(node, attrib, name, 1, [default])[0])
+    if nonnegative and value < 0:
+        raise node.error(f"{name}={attrib[name]!r} must be >= 0")
+    return value
+
+
+def keyword(node: Node, attrib: dict[str, str], name: str, default: str, allowed: tuple[str, ...]) -> str:
+    value = attrib.get(name, default)
+    if value not in allowed:
+        raise node.error(f"{name}={value!r} must be one of {', '.join(allowed)}")
+    return value
+
+
+def flag(node: Node, attrib: dict[str, str], name: str, default: str) -> str:
+    return keyword(node, attrib, name, default, ("true", "false", "auto"))
