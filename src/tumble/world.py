@@ -418,6 +418,16 @@ class World:
 
         return to_scene(self, dt=dt, duration=duration)
 
+    def to_mjcf(self, *, timestep: float | None = None) -> str:
+        """This world now as MJCF text, to be cross-checked in MuJoCo: joints as MuJoCo's body tree, loops as
+        equality constraints, exact mass properties, the present velocities as the keyframe ``now``; what MJCF
+        cannot say is refused with a ``ValueError`` naming it (``tumble/models/mjcf/export.py``)."""
+        from .models.mjcf.export import world_to_mjcf
+
+        if timestep is not None:
+            timestep = as_float("timestep", timestep, positive=True)
+        return world_to_mjcf(self, timestep=timestep)
+
     @property
     def joints(self) -> list[Joint]:
         """Every joint, in the order they were added."""

@@ -16,7 +16,7 @@ from ..rotation import quat_multiply, quat_rotate
 from ..shapes import Box, Capsule, ConvexHull, Cylinder, Plane, Sphere, TriMesh
 from .vehicles import vehicle_to_scene, wind_to_scene
 
-__all__ = ["world_to_scene"]
+__all__ = ["body_names", "joint_entry", "world_to_scene"]
 
 
 def _floats(values) -> list:
@@ -48,7 +48,8 @@ def _geometry(specs) -> dict:
                        for s in specs]}  # fmt: skip
 
 
-def _names(world) -> list[str]:
+def body_names(world) -> list[str]:
+    """Every body's name, a made-up unique one (``body7``) for a body without."""
     taken = {b.name for b in world.bodies if b.name is not None}
     names = []
     for body in world.bodies:
@@ -96,7 +97,8 @@ def _bounds(lower: float, upper: float, shift: float) -> dict:
     return out
 
 
-def _joint(joint, names: list[str]) -> dict:
+def joint_entry(joint, names: list[str]) -> dict:
+    """A joint as its scene entry at the bodies' present poses (``names``: :func:`body_names`)."""
     spec = joint._world._builder.joints[joint.index]
     lower, upper, speed, max_motor, hertz, ratio, target, cone = (float(v) for v in spec.drive)
     a, b = joint.body_a, joint.body_b
@@ -131,7 +133,7 @@ def _joint(joint, names: list[str]) -> dict:
 
 def world_to_scene(world, *, dt: float | None = None, duration: float | None = None) -> dict:
     """The scene dict of ``world`` now (``dt`` and ``duration`` default to the scene defaults)."""
-    names = _names(world)
+    names = body_names(world)
     solver = world.solver
     settings = {
         "gravity": _floats(world.gravity),
@@ -155,7 +157,7 @@ def world_to_scene(world, *, dt: float | None = None, duration: float | None = N
             _body(world, b, names[b.index]) for b in world.bodies if not b.is_static and b.index not in vehicles
         ],  # fmt: skip
         "static": [_placed(world, b, names[b.index]) for b in world.bodies if b.is_static],
-        "joints": [_joint(j, names) for j in world.joints],
+        "joints": [joint_entry(j, names) for j in world.joints],
         "vehicles": [vehicle_to_scene(quad, names[index]) for index, quad in vehicles.items()],
     }
     wind = wind_to_scene(world.wind)
