@@ -33,6 +33,20 @@ def __getattr__(name: str):
     raise AttributeError(f"module 'tumble' has no attribute {name!r}")
 
 
+def load_mjcf(path_or_xml, *, world=None, position=(0.0, 0.0, 0.0), orientation=(1.0, 0.0, 0.0, 0.0)) -> World:
+    """An MJCF model (a file path, or XML text starting with ``<``) in a world: ``world``, or a new one with the
+    model's gravity; the whole model placed at ``position``/``orientation``. Bodies with one joint each (or free, or
+    welded to a neighbour) collide and move with the world's joints; see docs/model_files.md."""
+    from ._validate import as_quaternion, as_vector3
+    from .models.build_world import to_world
+    from .models.mjcf import read_mjcf
+
+    if world is not None and not isinstance(world, World):
+        raise TypeError(f"world must be a tumble.World or None, got {world!r}")
+    position, orientation = as_vector3("position", position), as_quaternion("orientation", orientation)
+    return to_world(read_mjcf(path_or_xml), world, position, orientation)
+
+
 def load_scene(path) -> World:
     """The world described by the scene file at ``path`` (TOML or JSON; see ``docs/scenes.md``)."""
     from .scene_file import load
@@ -70,6 +84,7 @@ __all__ = [
     "__version__",
     "actuators",
     "control",
+    "load_mjcf",
     "load_scene",
     "mass",
     "rotation",

@@ -88,8 +88,8 @@ def test_each_unsupported_element_and_attribute_warns_once_with_its_first_line_a
     assert messages == [
         "<string>: <joint> bogus (line 3): not supported by tumble; ignored",
         "<string>: <joint> frictionloss (line 2 and 1 more): not simulated by tumble's Articulation (yet); ignored",
-        "<string>: <sensor> element (line 1): not loaded into an Articulation; ignored",
-        "<string>: <tendon> element (line 1): not loaded into an Articulation; ignored",
+        "<string>: <sensor> element (line 1): not loaded by tumble (yet); ignored",
+        "<string>: <tendon> element (line 1): not loaded by tumble (yet); ignored",
     ]
 
 

@@ -233,7 +233,9 @@ def _joint(reader: _Reader, node: Node, childclass: str, is_top: bool) -> JointD
         if kind != "ball" and low >= high:
             raise node.error(f"range={a.get('range')!r} must have its lower bound below the upper")
         bounds = (float(low), float(high))
-        reader.note(node, "range", "joint limits are not enforced by tumble's Articulation (yet); ignored")
+        reader.note(
+            node, "range", "joint limits are enforced in a World (tumble.load_mjcf), not by an Articulation (yet)"
+        )
     joint = JointDescription(
         name=a.get("name"),
         type=kind,
@@ -531,7 +533,7 @@ def describe(root: Node, base: Path) -> ModelDescription:
                 elif child.tag not in _SILENT:
                     reader.note(child, "element", "not supported by tumble; ignored")
         elif node.tag not in _SILENT and node.tag not in ("compiler", "default", "asset", "actuator"):
-            reader.note(node, "element", "not loaded into an Articulation; ignored")
+            reader.note(node, "element", "not loaded by tumble (yet); ignored")
     actuators = _read_actuators(reader, root, bodies)
     if reader.compiler.settotalmass > 0:
         bodies = _scaled_to_total(bodies, reader.compiler.settotalmass)

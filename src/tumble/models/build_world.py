@@ -1,0 +1,189 @@
+"""Builder: a :class:`~tumble.models.description.ModelDescription` into a :class:`~tumble.World`: bodies that collide,
+the world's joints, the ground.
+
+Every body with a joint becomes a world body at its pose in the model (MuJoCo's ``qpos0``), carrying the geoms and
+mass of the jointless bodies welded to it; bodies welded to the world are static geometry with the world's own
+geoms. A hinge, slide or ball joint to the parent becomes a :class:`~tumble.HingeJoint`,
+:class:`~tumble.SliderJoint` or :class:`~tumble.BallJoint` (a hinge's or slide's ``range`` its limits); a free joint
+leaves the body free. A world joint joins two bodies with one joint, so a body with several joints is refused
+(``tumble.articulation.from_mjcf`` loads it). Geoms become shapes (a mesh its convex hull, as MuJoCo collides it; an
+ellipsoid the hull of 162 points on it); geoms that collide with nothing (``contype = conaffinity = 0``) are left
+out. MuJoCo lets two geoms touch when ``contype₁ & conaffinity₂`` or ``contype₂ & conaffinity₁``; tumble's filter
+asks both of ``group₁ & mask₂`` and ``group₂ & mask₁``, so each distinct pair ``(contype, conaffinity)`` gets a bit
+of its own as its group, and its mask holds the bits of the pairs it touches: the same pairs collide.
+"""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+
+from ..joints import BallJoint, HingeJoint, SliderJoint
+from ..rotation import quat_multiply, quat_rotate
+from ..shapes import Box, Capsule, ConvexHull, Cylinder, Plane, Sphere
+from .description import GeomDescription, ModelDescription
+from .mjcf import MJCFWarning
+
+__all__ = ["to_world"]
+
+_IDENTITY = np.array([1.0, 0.0, 0.0, 0.0])
+
+
+def _compose(a, b):
+    """The pose ``b`` (in ``a``'s frame) in ``a``'s parent's frame."""
+    return a[0] + quat_rotate(a[1], b[0]), quat_multiply(a[1], b[1])
+
+
+def _relative(a, b):
+    """The pose ``b`` (world) in frame ``a`` (world)."""
+    inverse = a[1] * np.array([1.0, -1.0, -1.0, -1.0])
+    return quat_rotate(inverse, b[0] - a[0]), quat_multiply(inverse, b[1])
+
+
+def _ellipsoid_points(size) -> np.ndarray:
+    """162 points on an ellipsoid of half axes ``size``: a subdivided icosahedron's vertices, scaled."""
+    t = (1.0 + 5.0**0.5) / 2.0
+    points = [(-1, t, 0), (1, t, 0), (-1, -t, 0), (1, -t, 0), (0, -1, t), (0, 1, t), (0, -1, -t), (0, 1, -t),
+              (t, 0, -1), (t, 0, 1), (-t, 0, -1), (-t, 0, 1)]  # fmt: skip
+    cloud = np.array(points, float)
+    for _ in range(2):  # midpoints of every close pair: 12 -> 42 -> 162
+        unit = cloud / np.linalg.norm(cloud, axis=1)[:, None]
+        gaps = np.linalg.norm(unit[:, None] - unit[None], axis=2)
+        edge = np.min(gaps[gaps > 1e-9])
+        i, j = np.nonzero(np.triu(gaps < 1.01 * edge, 1))
+        cloud = np.vstack([unit, unit[i] + unit[j]])
+    return cloud / np.linalg.norm(cloud, axis=1)[:, None] * size
+
+
+def _shape(model: ModelDescription, geom: GeomDescription, moving: bool):
+    """The tumble shape of a geom, or None (with a warning) for one tumble cannot collide."""
+    r, h = geom.size[0], geom.size[1]
+    if geom.type == "sphere":
+        return Sphere(r)
+    if geom.type == "capsule":
+        return Capsule(r, 2.0 * h)
+    if geom.type == "cylinder":
+        return Cylinder(r, 2.0 * h)
+    if geom.type == "box":
+        return Box(2.0 * geom.size)
+    if geom.type == "ellipsoid":
+        return ConvexHull(_ellipsoid_points(geom.size))
+    if geom.type == "mesh":
+        return ConvexHull(model.meshes[geom.mesh].vertices)
+    if geom.type == "plane" and not moving:
+        return Plane()
+    warnings.warn(
+        f"{model.source}: <geom> type={geom.type!r} (line {geom.line}) does not collide in a tumble World "
+        f"{'on a moving body ' if geom.type == 'plane' else ''}(yet); left out",
+        MJCFWarning,
+        stacklevel=4,
+    )
+    return None
+
+
+def _filters(model: ModelDescription) -> dict[tuple[int, int], tuple[int, int]]:
+    """``(collision_group, collision_mask)`` for each ``(contype, conaffinity)`` in the model (module docstring)."""
+    pairs = sorted({(g.contype, g.conaffinity) for b in model.bodies for g in b.geoms} |
+                   {(g.contype, g.conaffinity) for g in model.world_geoms})  # fmt: skip
+    pairs = [p for p in pairs if p != (0, 0)]
+    if len(pairs) > 32:
+        raise ValueError(f"{model.source}: {len(pairs)} distinct (contype, conaffinity) pairs; tumble's collision "
+                         "filter holds 32")  # fmt: skip
+    bits = {pair: 1 << k for k, pair in enumerate(pairs)}
+    return {p: (bits[p], sum(bits[q] for q in pairs if (p[0] & q[1]) or (q[0] & p[1]))) for p in pairs}
+
+
+def _joint(model, body, world_body, parent, anchor_pose, rotation_quat):
+    """The world joint of ``body`` (one hinge, slide or ball) to ``parent`` (a world body, or None)."""
+    joint = body.joints[0]
+    anchor = anchor_pose
+    axis = quat_rotate(rotation_quat, joint.axis)
+    bounds = {}
+    if joint.range is not None and joint.type in ("hinge", "slide"):
+        low, high = joint.range[0] - joint.ref, joint.range[1] - joint.ref
+        # tumble measures b relative to a: the child relative to its parent, or the world relative to the child
+        bounds = {"lower": low, "upper": high} if parent is not None else {"lower": -high, "upper": -low}
+    a, b = (parent, world_body) if parent is not None else (world_body, None)
+    if joint.type == "hinge":
+        return HingeJoint(a, b, anchor, axis, **bounds)
+    if joint.type == "slide":
+        return SliderJoint(a, b, axis, anchor=anchor, **bounds)
+    return BallJoint(a, b, anchor)
+
+
+def _check(model: ModelDescription) -> None:
+    for body in model.bodies:
+        if len(body.joints) > 1:
+            raise ValueError(
+                f"{model.source}, line {body.line}: body {body.name!r} has {len(body.joints)} joints; a "
+                "tumble World joins two bodies with one joint (tumble.articulation.from_mjcf loads it)"
+            )
+    notes = sorted({name for b in model.bodies for j in b.joints for name in ("damping", "armature", "stiffness",
+                    "frictionloss") if getattr(j, name)})  # fmt: skip
+    if notes:
+        warnings.warn(f"{model.source}: joint {', '.join(notes)} are not simulated by a tumble World's joints (yet); "
+                      "ignored", MJCFWarning, stacklevel=3)  # fmt: skip
+    if model.actuators:
+        warnings.warn(f"{model.source}: {len(model.actuators)} actuators are not driven in a tumble World (yet); "
+                      "tumble.articulation.from_mjcf drives them", MJCFWarning, stacklevel=3)  # fmt: skip
+
+
+def to_world(model: ModelDescription, world=None, position=(0.0, 0.0, 0.0), orientation=_IDENTITY):
+    """The model's bodies, joints and geoms in ``world`` (a new one with the model's gravity if None), the whole
+    model placed at ``position``/``orientation``; returns the world."""
+    from ..world import World
+
+    _check(model)
+    world = World(gravity=model.gravity) if world is None else world
+    place = (np.asarray(position, float), np.asarray(orientation, float))
+    filters = _filters(model)
+    poses, movers = [], []  # each body's world pose, and the index of the body it moves with (-1: the world)
+    for index, body in enumerate(model.bodies):
+        parent = place if body.parent < 0 else poses[body.parent]
+        poses.append(_compose(parent, (body.pos, body.quat)))
+        movers.append(index if body.joints else (-1 if body.parent < 0 else movers[body.parent]))
+    handles: dict[int, object] = {}
+    static_geoms = [(place, geom) for geom in model.world_geoms]
+    for index, body in enumerate(model.bodies):
+        if movers[index] < 0:
+            static_geoms += [(poses[index], geom) for geom in body.geoms]
+            continue
+        if movers[index] != index:
+            continue
+        welded = [k for k in range(len(model.bodies)) if movers[k] == index]
+        frame = poses[index]
+        shapes, mass, first = [], None, None
+        for k in welded:
+            local = _relative(frame, poses[k])
+            for geom in model.bodies[k].geoms:
+                shape = None if (geom.contype, geom.conaffinity) == (0, 0) else _shape(model, geom, True)
+                if shape is not None:
+                    shapes.append((shape, *_compose(local, (geom.pos, geom.quat))))
+                    first = first or geom
+            mp = model.bodies[k].mass_properties
+            if mp is not None:
+                moved = mp.transformed(rotation=local[1], translation=local[0])
+                mass = moved if mass is None else mass + moved
+        if mass is None:
+            raise ValueError(f"{model.source}, line {body.line}: body {body.name!r} moves but has no mass")
+        group, mask = filters[(first.contype, first.conaffinity)] if first is not None else (1, 0)
+        handles[index] = world.add_body(shapes or None, mass_properties=mass, position=frame[0], orientation=frame[1],
+                                        friction=float(first.friction[0]) if first is not None else 0.5,
+                                        collision_group=group, collision_mask=mask, name=body.name)  # fmt: skip
+    for pose, geom in static_geoms:
+        if (geom.contype, geom.conaffinity) == (0, 0) or (shape := _shape(model, geom, False)) is None:
+            continue
+        group, mask = filters[(geom.contype, geom.conaffinity)]
+        at = _compose(pose, (geom.pos, geom.quat))
+        world.add_static(shape, position=at[0], orientation=at[1], friction=float(geom.friction[0]),
+                         collision_group=group, collision_mask=mask, name=geom.name)  # fmt: skip
+    for index, handle in handles.items():
+        body = model.bodies[index]
+        if body.joints[0].type == "free":
+            continue
+        parent = movers[body.parent] if body.parent >= 0 else -1
+        frame = poses[index]
+        anchor = frame[0] + quat_rotate(frame[1], body.joints[0].pos)
+        world.add_joint(_joint(model, body, handle, handles.get(parent), anchor, frame[1]))
+    return world

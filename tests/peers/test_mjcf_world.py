@@ -1,0 +1,99 @@
+"""``tumble.load_mjcf``: MJCF models in a World, colliding, with the world's joints.
+
+Gymnasium's ant (a free torso, eight single-hinge leg segments with limits, capsules, a plane) loads with its
+bodies where MuJoCo puts them, its masses, and MuJoCo's collision filter (the ant's geoms touch the floor, not each
+other); dropped, it comes to rest on the floor. Models whose bodies have several joints are refused naming the body.
+"""
+
+from __future__ import annotations
+
+import os
+import warnings
+
+import numpy as np
+import pytest
+
+import tumble
+from tumble.models.build_world import _filters
+from tumble.models.mjcf import read_mjcf
+
+mujoco = pytest.importorskip("mujoco")
+gymnasium = pytest.importorskip("gymnasium")
+pytestmark = pytest.mark.peers
+
+ASSETS = os.path.join(os.path.dirname(gymnasium.__file__), "envs", "mujoco", "assets")
+ANT = os.path.join(ASSETS, "ant.xml")
+
+
+def quiet_load(source, **placement):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return tumble.load_mjcf(source, **placement)
+
+
+def test_the_ant_loads_where_mujoco_puts_it_with_its_masses():
+    world = quiet_load(ANT)
+    model = mujoco.MjModel.from_xml_path(ANT)
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    moving = {b.name: b for b in world.bodies if not b.is_static}
+    assert len(world.joints) == 8 and all(j.kind == "hinge" for j in world.joints)
+    # the jointless upper legs are welded into the torso: its mass is theirs too
+    torso = model.body("torso").id
+    welded = [i for i in range(model.nbody) if model.body_jntnum[i] == 0 and model.body_parentid[i] == torso]
+    assert moving["torso"].mass == pytest.approx(model.body_mass[torso] + model.body_mass[welded].sum(), rel=1e-12)
+    jointed = [i for i in range(model.nbody) if model.body_jntnum[i] > 0]  # in order, as the world's bodies
+    bodies = [b for b in world.bodies if not b.is_static]
+    assert len(bodies) == len(jointed)
+    for body, i in zip(bodies, jointed, strict=True):
+        np.testing.assert_allclose(body.position, data.xpos[i], rtol=0, atol=1e-12)
+        assert abs(abs(np.dot(body.orientation, data.xquat[i])) - 1.0) < 1e-14
+        if i != torso:
+            assert body.mass == pytest.approx(model.body_mass[i], rel=1e-12)
+    assert sum(b.mass for b in bodies) == pytest.approx(model.body_mass.sum(), rel=1e-12)
+
+
+def test_the_ant_dropped_comes_to_rest_on_the_floor_touching_only_it():
+    world = quiet_load(ANT)
+    for _ in range(240 * 3):
+        world.step(1 / 240)
+    speeds = [np.linalg.norm(b.velocity) for b in world.bodies if not b.is_static]
+    assert max(speeds) < 1e-3
+    contacts = world.contacts()
+    floor = next(b for b in world.bodies if b.is_static)
+    assert len(contacts) > 0
+    touching = (contacts.body_a == floor.index) | (contacts.body_b == floor.index)
+    assert touching.all()  # MuJoCo's filter: the ant's geoms touch the floor, never each other
+    assert contacts.separation.min() > -0.005
+
+
+def test_collision_filters_pair_what_mujoco_pairs():
+    description = read_mjcf(ANT)
+    filters = _filters(description)
+    for (ct1, ca1), (g1, m1) in filters.items():
+        for (ct2, ca2), (g2, m2) in filters.items():
+            assert bool((g1 & m2) and (g2 & m1)) == bool((ct1 & ca2) or (ct2 & ca1))
+
+
+def test_a_model_is_placed_and_added_to_an_existing_world():
+    world = tumble.World(gravity=(0.0, 0.0, -1.0))
+    world.add_static(tumble.Plane())
+    turn = (np.cos(0.25), 0.0, 0.0, np.sin(0.25))
+    quiet_load(os.path.join(ASSETS, "inverted_pendulum.xml"), world=world, position=(1.0, 2.0, 0.5), orientation=turn)
+    alone = quiet_load(os.path.join(ASSETS, "inverted_pendulum.xml"))
+    pole = next(b for b in world.bodies if b.name == "pole")
+    reference = next(b for b in alone.bodies if b.name == "pole")
+    expected = np.array([1.0, 2.0, 0.5]) + tumble.rotation.quat_rotate(np.array(turn), reference.position)
+    np.testing.assert_allclose(pole.position, expected, atol=1e-12)
+    np.testing.assert_array_equal(world.gravity, (0.0, 0.0, -1.0))  # an existing world keeps its gravity
+
+
+def test_a_body_with_several_joints_and_bad_arguments_are_refused():
+    with pytest.raises(ValueError, match=r"hopper\.xml, line 20: body 'torso' has 3 joints; a tumble World joins"):
+        quiet_load(os.path.join(ASSETS, "hopper.xml"))
+    with pytest.raises(TypeError, match="world must be a tumble.World or None"):
+        tumble.load_mjcf(ANT, world="mine")
+    with pytest.raises(ValueError, match="orientation"):
+        tumble.load_mjcf(ANT, orientation=(0, 0, 0, 0))
+    with pytest.warns(UserWarning, match=r"ant\.xml: 8 actuators are not driven in a tumble World \(yet\)"):
+        tumble.load_mjcf(ANT)
