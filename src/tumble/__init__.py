@@ -37,14 +37,9 @@ def load_mjcf(path_or_xml, *, world=None, position=(0.0, 0.0, 0.0), orientation=
     """An MJCF model (a file path, or XML text starting with ``<``) in a world: ``world``, or a new one with the
     model's gravity; the whole model placed at ``position``/``orientation``. Bodies with one joint each (or free, or
     welded to a neighbour) collide and move with the world's joints; see docs/model_files.md."""
-    from ._validate import as_quaternion, as_vector3
-    from .models.build_world import to_world
-    from .models.mjcf import read_mjcf
+    from .models.build_world import load_mjcf as load
 
-    if world is not None and not isinstance(world, World):
-        raise TypeError(f"world must be a tumble.World or None, got {world!r}")
-    position, orientation = as_vector3("position", position), as_quaternion("orientation", orientation)
-    return to_world(read_mjcf(path_or_xml), world, position, orientation)
+    return load(path_or_xml, world=world, position=position, orientation=orientation)
 
 
 def load_scene(path) -> World:

@@ -31,6 +31,7 @@ import signal
 import sys
 import tempfile
 import time
+import warnings
 import weakref
 from pathlib import Path
 
@@ -159,9 +160,19 @@ def _load_scene(text: str):
 
     path = _scene_path(text)
     try:
-        return path, scene_file.load(path)
+        with warnings.catch_warnings(record=True) as heard:
+            warnings.simplefilter("always")
+            loaded = scene_file.load(path)
     except scene_file.SceneError as error:
         raise BadInput(str(error)) from None
+    from .models.mjcf import MJCFWarning
+
+    for message in dict.fromkeys(str(w.message) for w in heard if issubclass(w.category, MJCFWarning)):
+        _note(message)  # a model file's: what tumble does not simulate
+    for w in heard:
+        if not issubclass(w.category, MJCFWarning):
+            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+    return path, loaded
 
 
 def _load_trajectory(path: str):
@@ -611,7 +622,11 @@ def _world_from_metadata(trajectory, source_name: str):
         return None, "this tumble cannot rebuild a scene from a dict"
     base = Path(scene["path"]).parent if isinstance(scene.get("path"), str) else Path(".")
     try:
-        loaded = from_dict(scene["source"], base=base, label=str(scene.get("file", "<stored scene>")))
+        from .models.mjcf import MJCFWarning
+
+        with warnings.catch_warnings():  # a model file's notes were given when it was run
+            warnings.simplefilter("ignore", MJCFWarning)
+            loaded = from_dict(scene["source"], base=base, label=str(scene.get("file", "<stored scene>")))
     except (ValueError, TypeError) as error:  # SceneError is a ValueError
         return None, f"the scene stored in {source_name} does not build here: {str(error).splitlines()[0]}"
     return loaded.world, None

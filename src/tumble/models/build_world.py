@@ -25,7 +25,7 @@ from ..shapes import Box, Capsule, ConvexHull, Cylinder, Plane, Sphere
 from .description import GeomDescription, ModelDescription
 from .mjcf import MJCFWarning
 
-__all__ = ["to_world"]
+__all__ = ["load_mjcf", "to_world"]
 
 _IDENTITY = np.array([1.0, 0.0, 0.0, 0.0])
 
@@ -187,3 +187,15 @@ def to_world(model: ModelDescription, world=None, position=(0.0, 0.0, 0.0), orie
         anchor = frame[0] + quat_rotate(frame[1], body.joints[0].pos)
         world.add_joint(_joint(model, body, handle, handles.get(parent), anchor, frame[1]))
     return world
+
+
+def load_mjcf(path_or_xml, *, world=None, position=(0.0, 0.0, 0.0), orientation=_IDENTITY):
+    """``tumble.load_mjcf``: validate the placement, read the model, build it into ``world`` (or a new one)."""
+    from .._validate import as_quaternion, as_vector3
+    from ..world import World
+    from .mjcf import read_mjcf
+
+    if world is not None and not isinstance(world, World):
+        raise TypeError(f"world must be a tumble.World or None, got {world!r}")
+    position, orientation = as_vector3("position", position), as_quaternion("orientation", orientation)
+    return to_world(read_mjcf(path_or_xml), world, position, orientation)

@@ -17,6 +17,7 @@ import gc
 import json
 import reprlib
 import tomllib
+import warnings
 from contextlib import contextmanager
 from dataclasses import dataclass
 from functools import cached_property
@@ -139,12 +140,28 @@ def from_dict(data: dict, *, base: Path | str = ".", label: str = "<scene>") -> 
     return LoadedScene(world, run, scene)
 
 
+def _model_scene(path: Path) -> LoadedScene:
+    """A model file (MJCF) as a scene of that one model, with its gravity and its timestep as the step."""
+    from ..models.mjcf import MJCFError, read_mjcf
+
+    try:
+        with warnings.catch_warnings():  # read for its options only; building it reads it again, and warns
+            warnings.simplefilter("ignore")
+            model = read_mjcf(path)
+    except (MJCFError, OSError) as error:
+        raise SceneError(str(error)) from None
+    data = {"world": {"gravity": model.gravity.tolist(), "dt": float(model.timestep)}, "models": [{"path": path.name}]}
+    return from_dict(data, base=path.parent, label=path.name)
+
+
 def load(path) -> LoadedScene:
-    """Read, validate and build the scene file at ``path`` (``.toml`` or ``.json``)."""
+    """Read, validate and build the scene file at ``path`` (``.toml`` or ``.json``, or an MJCF model: ``.xml``)."""
     path = Path(path)
     label = path.name
+    if path.suffix.lower() == ".xml":
+        return _model_scene(path)
     if path.suffix not in (".toml", ".json"):
-        raise SceneError(f"{label}: a scene file must end in .toml or .json")
+        raise SceneError(f"{label}: a scene file must end in .toml or .json (or be an MJCF model, .xml)")
     try:
         text = path.read_bytes().decode("utf-8-sig")  # a byte-order mark, as some editors write, is skipped
     except OSError as error:

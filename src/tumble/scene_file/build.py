@@ -162,6 +162,24 @@ def _vehicles(world, specs, label: str) -> dict:
     return named
 
 
+def _model(world: World, spec: schema.Model, base: Path, place: str, label: str) -> dict:
+    """Load the model file ``spec`` names into ``world``; its named bodies, for the scene's joints."""
+    from ..models.build_world import load_mjcf
+    from ..models.mjcf import MJCFError
+
+    path = (base / spec.path).resolve()
+    if not path.is_file():
+        raise SceneError(f"{label}: {place}.path: no model file {spec.path!r} (looked for {path})")
+    if path.suffix.lower() != ".xml":
+        raise SceneError(f"{label}: {place}.path: a model file is MJCF, ending in .xml; got {spec.path!r}")
+    before = len(world.bodies)
+    try:
+        load_mjcf(path, world=world, position=spec.position, orientation=spec.orientation)
+    except (MJCFError, ValueError, TypeError) as error:
+        raise SceneError(f"{label}: {place}: {error}") from None
+    return {body.name: body for body in world.bodies[before:] if body.name is not None}
+
+
 def build_world(scene: schema.Scene, base: Path, label: str) -> World:
     """The world a validated scene describes; ``base`` is the directory mesh paths are relative to."""
     settings = scene.world
@@ -219,6 +237,8 @@ def build_world(scene: schema.Scene, base: Path, label: str) -> World:
         except (ValueError, TypeError) as error:
             raise SceneError(f"{label}: {place}: {error}") from error
         named.update({body.name: body for body in copy.bodies})
+    for k, spec in enumerate(scene.models):
+        named.update(_model(world, spec, base, f"models[{k}]", label))
     try:
         world.wind = build_wind(scene.wind)
     except (ValueError, TypeError) as error:

@@ -284,6 +284,15 @@ class Articulation(_Strict):
     qd: list[Finite] | None = None
 
 
+class Model(_Strict):
+    """A model file (MJCF) put into the world with ``tumble.load_mjcf``: ``path`` relative to the scene file, the
+    whole model at ``position``/``orientation``; its bodies keep the model's names (scene joints may refer to them)."""
+
+    path: Path
+    position: Vector3 = (0.0, 0.0, 0.0)
+    orientation: Quaternion = (1.0, 0.0, 0.0, 0.0)
+
+
 # --- vehicles and wind (docs/quadrotor.md) ----------------------------------------------------------------
 
 Gain = Finite | Vector3  # one number for every axis, or one per axis
@@ -443,7 +452,8 @@ class Recording(_Strict):
 
 class Scene(_Strict):
     """A scene file: ``[world]``, ``[materials.NAME]``, ``[[bodies]]``, ``[[static]]``, ``[[joints]]``,
-    ``[[articulations]]``, ``[[vehicles]]``, ``[wind]``, ``[recording]``, and a free-text ``description``."""
+    ``[[articulations]]``, ``[[models]]``, ``[[vehicles]]``, ``[wind]``, ``[recording]``, and a free-text
+    ``description``."""
 
     description: str = ""
     world: WorldSettings = WorldSettings()
@@ -452,6 +462,7 @@ class Scene(_Strict):
     static: list[Static] = []
     joints: list[Joint] = []
     articulations: list[Articulation] = []
+    models: list[Model] = []
     vehicles: list[Vehicle] = []
     wind: Wind | None = None
     recording: Recording = Recording()
