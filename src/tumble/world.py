@@ -17,6 +17,7 @@ import numpy as np
 from . import diagnostics
 from ._validate import (
     MAX_COUNT,
+    as_array,
     as_count,
     as_filter,
     as_float,
@@ -234,6 +235,7 @@ class World:
         self._sensors = Sensors()
         self._wind: Wind | None = None
         self._vehicles: list = []  # tumble.vehicles.Quadrotor, each one body with its actuators
+        self._joint_drives = None  # tumble.joint_drives.JointDrives, made with the first joint actuator
 
     @classmethod
     def _from_builder(cls, builder: ModelBuilder, state: State, inputs: Inputs, *, gravity, params: Params) -> World:
@@ -378,6 +380,48 @@ class World:
     def actuators(self) -> list[Actuator]:
         """The actuators, in the order added."""
         return list(self._actuation.actuators)
+
+    def add_joint_actuator(self, joint: Joint, *, gear=1.0, gain=1.0, bias=(0.0, 0.0, 0.0), ctrl_range=None,
+                           ref=0.0, name: str | None = None):  # fmt: skip
+        """Drive a hinge or slider from ``world.ctrl`` (its new last entry, starting at 0); returns its record.
+
+        The actuator pulls along its length ``l = gear · (ref + q)`` (``q`` the joint's angle or translation, zero
+        at its creation; ``ref`` the coordinate that is, MJCF's ``ref``) with ``f = gain · c + bias[0] + bias[1] l
+        + bias[2] l̇`` (``c`` the control clipped to ``ctrl_range``) and turns (pushes) the joint's second body with
+        ``gear · f``, the first with the opposite: a motor is the default, a position servo ``gain=kp, bias=(0,
+        -kp, -kv)``, a velocity servo ``gain=kv, bias=(0, 0, -kv)`` (``tumble/joint_drives.py``). The loads are
+        worked out before each step and held through it."""
+        from .joint_drives import JointDrives
+
+        if not isinstance(joint, Joint) or joint._world is not self:
+            raise TypeError(f"joint must be a joint of this world, got {joint!r}")
+        gear, gain, ref = as_float("gear", gear), as_float("gain", gain), as_float("ref", ref)
+        bias = as_array("bias", bias, (3,), batch=False)
+        if ctrl_range is not None:
+            low, high = (float(v) for v in as_array("ctrl_range", ctrl_range, (2,), batch=False))
+            if not low <= high:
+                raise ValueError(f"ctrl_range must be (low, high) with low <= high, got {ctrl_range!r}")
+            ctrl_range = (low, high)
+        if self._joint_drives is None:
+            self._joint_drives = JointDrives()
+        return self._joint_drives.add(self, joint, gear=gear, gain=gain, bias=bias, ctrl_range=ctrl_range, ref=ref,
+                                      name=name)  # fmt: skip
+
+    @property
+    def ctrl(self) -> np.ndarray:
+        """(number of joint actuators,) their controls (a copy), held until set again."""
+        return np.zeros(0) if self._joint_drives is None else self._joint_drives.ctrl.copy()
+
+    @ctrl.setter
+    def ctrl(self, value) -> None:
+        size = 0 if self._joint_drives is None else len(self._joint_drives.drives)
+        values = np.array(as_array("ctrl", value, (size,), batch=False), dtype=float)
+        if size:
+            self._joint_drives.ctrl = values
+
+    def actuator_forces(self) -> np.ndarray:
+        """Each joint actuator's force along its length now, before its gear (MuJoCo's ``actuator_force``)."""
+        return np.zeros(0) if self._joint_drives is None else self._joint_drives.forces(self)
 
     def add_drag(self, body: Body, coefficients) -> None:
         """Parasitic drag on ``body``: the force ``−c ⊙ |v_air| v_air`` at its COM, in its frame, with ``c =
@@ -879,6 +923,9 @@ class World:
         bit; see ``docs/files.md``."""
         from .checkpoint import save_world
 
+        if self._joint_drives is not None:
+            raise ValueError(f"save: the world has {len(self._joint_drives.drives)} joint actuators (world.ctrl), "
+                             "which checkpoints do not hold (yet)")  # fmt: skip
         save_world(self, path)
 
     @classmethod

@@ -101,9 +101,9 @@ def _joint(model, body, world_body, parent, anchor_pose, rotation_quat):
     axis = quat_rotate(rotation_quat, joint.axis)
     bounds = {}
     if joint.range is not None and joint.type in ("hinge", "slide"):
-        low, high = joint.range[0] - joint.ref, joint.range[1] - joint.ref
-        # tumble measures b relative to a: the child relative to its parent, or the world relative to the child
-        bounds = {"lower": low, "upper": high} if parent is not None else {"lower": -high, "upper": -low}
+        # zero at the model's pose, where MuJoCo's coordinate is ``ref``; tumble measures the child's turn (or
+        # travel) relative to its parent or, joined to the world, relative to the world: MuJoCo's sense both ways
+        bounds = {"lower": joint.range[0] - joint.ref, "upper": joint.range[1] - joint.ref}
     a, b = (parent, world_body) if parent is not None else (world_body, None)
     if joint.type == "hinge":
         return HingeJoint(a, b, anchor, axis, **bounds)
@@ -124,9 +124,6 @@ def _check(model: ModelDescription) -> None:
     if notes:
         warnings.warn(f"{model.source}: joint {', '.join(notes)} are not simulated by a tumble World's joints (yet); "
                       "ignored", MJCFWarning, stacklevel=3)  # fmt: skip
-    if model.actuators:
-        warnings.warn(f"{model.source}: {len(model.actuators)} actuators are not driven in a tumble World (yet); "
-                      "tumble.articulation.from_mjcf drives them", MJCFWarning, stacklevel=3)  # fmt: skip
 
 
 def to_world(model: ModelDescription, world=None, position=(0.0, 0.0, 0.0), orientation=_IDENTITY):
@@ -178,6 +175,7 @@ def to_world(model: ModelDescription, world=None, position=(0.0, 0.0, 0.0), orie
         at = _compose(pose, (geom.pos, geom.quat))
         world.add_static(shape, position=at[0], orientation=at[1], friction=float(geom.friction[0]),
                          collision_group=group, collision_mask=mask, name=geom.name)  # fmt: skip
+    joints = {}
     for index, handle in handles.items():
         body = model.bodies[index]
         if body.joints[0].type == "free":
@@ -185,7 +183,12 @@ def to_world(model: ModelDescription, world=None, position=(0.0, 0.0, 0.0), orie
         parent = movers[body.parent] if body.parent >= 0 else -1
         frame = poses[index]
         anchor = frame[0] + quat_rotate(frame[1], body.joints[0].pos)
-        world.add_joint(_joint(model, body, handle, handles.get(parent), anchor, frame[1]))
+        joints[body.joints[0].name] = (world.add_joint(_joint(model, body, handle, handles.get(parent), anchor,
+                                                              frame[1])), body.joints[0])  # fmt: skip
+    for actuator in model.actuators:  # on hinges and slides, which every loaded body has at most one of
+        joint, description = joints[actuator.joint]
+        world.add_joint_actuator(joint, gear=actuator.gear, gain=actuator.gain, bias=actuator.bias,
+                                 ctrl_range=actuator.ctrl_range, ref=description.ref, name=actuator.name)  # fmt: skip
     return world
 
 

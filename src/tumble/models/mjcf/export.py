@@ -79,7 +79,7 @@ def _geoms(world, body, name: str, assets: list[str], pose=None) -> str:
 
 
 def _refuse_what_mjcf_cannot_say(world, joints: list[dict]) -> None:
-    if world._vehicles or world.actuators:
+    if world._vehicles or world.actuators or len(world.ctrl):
         raise ValueError("to_mjcf: the world has vehicles or actuators, which are not written to MJCF (yet)")
     for entry in joints:
         label = f"the {entry['type']} joint of {entry['a']!r} and {entry['b']!r}"
