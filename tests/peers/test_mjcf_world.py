@@ -160,3 +160,25 @@ def test_joint_actuators_refuse_bad_controls_and_joints_and_are_not_written_to_m
         world.to_mjcf()
     with pytest.raises(ValueError, match=r"save: the world has 1 joint actuators \(world.ctrl\)"):
         world.save("never.npz")
+
+
+@pytest.mark.parametrize("parent", ["world", "cart"])
+def test_a_hinge_limit_stops_the_arm_where_mujocos_does(parent):
+    """An arm falling about a hinge with range -10° to 20° stops at +20° (positive turns about +y take +x down),
+    hinged to the world or to a heavy cart on a horizontal slide, in both engines."""
+    arm = ('<body name="arm" pos="0 0 1"><joint name="elbow" axis="0 1 0" range="-10 20"/>'
+           '<geom type="capsule" fromto="0 0 0 0.5 0 0" size="0.02" mass="1"/></body>')  # fmt: skip
+    if parent == "cart":
+        arm = ('<body name="cart"><joint type="slide" axis="1 0 0"/><geom type="box" size="0.1 0.1 0.1" mass="1000" '
+               f'contype="0" conaffinity="0"/>{arm}</body>')  # fmt: skip
+    xml = f"<mujoco><option timestep='0.002'/><worldbody>{arm}</worldbody></mujoco>"
+    world = quiet_load(xml)
+    model = mujoco.MjModel.from_xml_string(xml)
+    data = mujoco.MjData(model)
+    mujoco.mj_step(model, data, nstep=1000)
+    for _ in range(480):
+        world.step(1 / 240)
+    elbow = world.joints[-1]
+    assert (elbow.body_b is None) == (parent == "world")
+    assert data.qpos[model.joint("elbow").qposadr[0]] == pytest.approx(np.radians(20.0), abs=0.01)
+    assert elbow.angle == pytest.approx(np.radians(20.0), abs=0.01)
