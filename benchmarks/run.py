@@ -26,6 +26,8 @@ Run from the repository root:
                  a sphere on a plane (``benchmarks/first_run.py``; only with ``--only``, about five minutes).
 ``model_files``  loading MJCF: Gymnasium's humanoid and a 100-link chain, tumble's reader and builder beside MuJoCo's
                  compiler (``benchmarks/model_files.py``).
+``mjcf_contacts`` Gymnasium's ant with contacts and its motors driven, in a tumble World and in MuJoCo at its 0.01 s
+                 step (``benchmarks/model_files.py``).
 ``broad_phase``  world bounds and sort-and-sweep pairs alone, on a pile and a scatter of 1k and 5k shapes
                  (``benchmarks/broad_phase.py``; tumble only: no peer exposes its broad phase).
 
@@ -732,6 +734,9 @@ BENCHMARKS: dict[str, Callable[[Sizes], list[dict]]] = {
     "first_run": first_run.bench_first_run,
     "model_files": lambda sizes: model_files.bench_model_files(
         chain_links=100 if sizes.repeat > 1 else 5, repeat=max(1, min(sizes.repeat, 5))
+    ),
+    "mjcf_contacts": lambda sizes: model_files.bench_mjcf_contacts(
+        seconds=5.0 if sizes.repeat > 1 else 0.1, repeat=max(1, min(sizes.repeat, 3))
     ),
 }
 OPTIONAL = ("big_pyramid", "first_run")  # slow: run only when asked for with --only

@@ -264,6 +264,14 @@ def test_model_files_rows_for_every_loader():
     assert {r["loader"] for r in rows if r["model"] == "chain of 3"} >= {"tumble read_mjcf", "tumble from_mjcf"}
 
 
+def test_mjcf_contacts_rows_for_both_engines():
+    from benchmarks import model_files
+
+    rows = model_files.bench_mjcf_contacts(seconds=0.05, repeat=1)
+    _assert_finite_numbers(rows)
+    assert {r["engine"] for r in rows} >= {"tumble World"}
+
+
 def test_broad_phase_rows_for_both_worlds_and_pairs_in_the_pile():
     from benchmarks import broad_phase
 

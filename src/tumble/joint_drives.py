@@ -68,37 +68,41 @@ class JointDrives:
         return out
 
     def apply(self, world, t) -> None:
-        """Before a step: each actuator's torque (or force) on its two bodies."""
-        for drive, force in zip(self.drives, self.forces(world), strict=True):
-            joint = drive.joint
-            spec = world._builder.joints[joint.index]
-            frame = spec.local_frame_a
-            if spec.body_a >= 0:
-                frame = _multiply(world.state.body_quat[spec.body_a], frame)
-            load = drive.gear * force * _x_axis(frame)
-            # the coordinate is the second body's motion relative to the first (or to the world)
-            moving, other = (joint.body_b, joint.body_a) if joint.body_b is not None else (joint.body_a, None)
-            for body, sign in ((moving, 1.0), (other, -1.0)):
-                if body is None or body.is_static:
+        """Before a step: each actuator's torque (or force) on its two bodies, added to the step's loads at once."""
+        loads = np.array([d.gear for d in self.drives]) * self.forces(world)
+        state, inputs = world.state, world.inputs
+        specs = [world._builder.joints[d.joint.index] for d in self.drives]
+        # the joint's axis: the x axis of its frame, kept in the first body's frame (the world's, if that is it)
+        frames = np.array([spec.local_frame_a for spec in specs])
+        first = np.array([spec.body_a for spec in specs])
+        held = first >= 0
+        frames[held] = _multiply(state.body_quat[first[held]], frames[held])
+        loads = loads[:, None] * _x_axis(frames)
+        hinge = np.array([d.joint.kind == "hinge" for d in self.drives])
+        # the coordinate is the second body's motion relative to the first (or to the world)
+        for bodies, sign in (([spec.body_b for spec in specs], 1.0), (first, -1.0)):
+            for k, body in enumerate(bodies):
+                if body < 0 or world._builder.rows[body].mass_properties is None:
                     continue
-                # a driven body stays awake, as every body does in MuJoCo: a servo settling slowly must not have its
-                # speed zeroed by falling asleep
-                world._state.body_sleep_time[body.index] = 0.0
-                if joint.kind == "hinge":
-                    body.apply_torque(sign * load)
-                else:
-                    body.apply_force(sign * load)
+                target = inputs.body_torque if hinge[k] else inputs.body_force
+                target[body] += sign * loads[k]
+                # a driven body stays awake, as every body does in MuJoCo: a servo settling slowly must not have
+                # its speed zeroed by falling asleep
+                if state.body_sleeping[body]:
+                    island = state.body_island == state.body_island[body]
+                    state.body_sleeping[island] = False
+                state.body_sleep_time[body] = 0.0
 
 
-def _multiply(a, b) -> tuple[float, float, float, float]:
-    """The Hamilton product ``a ⊗ b`` on plain floats (the validated ``rotation`` functions cost 0.1 ms a call)."""
-    aw, ax, ay, az = (float(v) for v in a)
-    bw, bx, by, bz = (float(v) for v in b)
-    return (aw * bw - ax * bx - ay * by - az * bz, aw * bx + ax * bw + ay * bz - az * by,
-            aw * by - ax * bz + ay * bw + az * bx, aw * bz + ax * by - ay * bx + az * bw)  # fmt: skip
+def _multiply(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Hamilton products ``a ⊗ b`` of (n, 4) quaternions, row by row."""
+    aw, ax, ay, az = a.T
+    bw, bx, by, bz = b.T
+    return np.stack([aw * bw - ax * bx - ay * by - az * bz, aw * bx + ax * bw + ay * bz - az * by,
+                     aw * by - ax * bz + ay * bw + az * bx, aw * bz + ax * by - ay * bx + az * bw], axis=1)  # fmt: skip
 
 
-def _x_axis(q) -> np.ndarray:
-    """The x axis of the frame the unit quaternion ``q`` turns to: the first column of its rotation matrix."""
-    w, x, y, z = (float(v) for v in q)
-    return np.array([1.0 - 2.0 * (y * y + z * z), 2.0 * (x * y + w * z), 2.0 * (x * z - w * y)])
+def _x_axis(q: np.ndarray) -> np.ndarray:
+    """The x axes of the frames the (n, 4) unit quaternions turn to: the first columns of their rotation matrices."""
+    w, x, y, z = q.T
+    return np.stack([1.0 - 2.0 * (y * y + z * z), 2.0 * (x * y + w * z), 2.0 * (x * z - w * y)], axis=1)
