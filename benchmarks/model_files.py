@@ -7,10 +7,11 @@ Run from the repository root:
 Models: Gymnasium's humanoid (13 bodies, 21 degrees of freedom, default classes, capsules from ``fromto``), a
 generated chain of ``chain_links`` (100) capsule links hinged about y, one nested in the other, and dm_control's dog
 (62 bodies, 85 degrees of freedom, 162 STL bone meshes weighed in MuJoCo's legacy mode, ``springdamper`` joints).
-Rows: tumble's ``read_mjcf`` (the XML into the plain description: parse, defaults, inertia from the geoms), ``from_mjcf`` (that and
-the articulation), ``from_mjcf`` and a first mass matrix (the articulation packed for its kernels; the kernels
-are loaded from Numba's cache before timing), and MuJoCo's ``MjModel.from_xml_path`` (parse and compile). Columns:
-``ms`` (best of ``repeat`` loads) and ``x_mujoco`` (tumble's time over MuJoCo's: below 1 is faster).
+Rows: tumble's ``read_mjcf`` (the XML into the plain description: parse, defaults, inertia from the geoms),
+``from_mjcf`` (that and the articulation), ``from_mjcf`` and a first mass matrix (the articulation packed for its
+kernels; the kernels are loaded from Numba's cache before timing), and MuJoCo's ``MjModel.from_xml_path`` (parse and
+compile). Columns: ``ms`` (best of ``repeat`` loads) and ``x_mujoco`` (tumble's time over MuJoCo's: below 1 is
+faster).
 """
 
 from __future__ import annotations
