@@ -91,6 +91,11 @@ def test_a_model_is_placed_and_added_to_an_existing_world():
 def test_a_body_with_several_joints_and_bad_arguments_are_refused():
     with pytest.raises(ValueError, match=r"hopper\.xml, line 20: body 'torso' has 3 joints; a tumble World joins"):
         quiet_load(os.path.join(ASSETS, "hopper.xml"))
+    world = quiet_load(ANT)
+    count = len(world.bodies)
+    with pytest.raises(ValueError, match=r"ant\.xml: the name 'torso' is taken in the world"):
+        quiet_load(ANT, world=world)
+    assert len(world.bodies) == count and len(world.joints) == 8  # nothing of the second ant was added
     with pytest.raises(TypeError, match="world must be a tumble.World or None"):
         tumble.load_mjcf(ANT, world="mine")
     with pytest.raises(ValueError, match="orientation"):

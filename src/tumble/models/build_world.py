@@ -20,6 +20,7 @@ import warnings
 import numpy as np
 
 from ..joints import BallJoint, HingeJoint, SliderJoint
+from ..mass import require_invertible
 from ..rotation import quat_multiply, quat_rotate
 from ..shapes import Box, Capsule, ConvexHull, Cylinder, Plane, Sphere
 from .description import GeomDescription, ModelDescription
@@ -126,6 +127,34 @@ def _check(model: ModelDescription) -> None:
                       "ignored", MJCFWarning, stacklevel=3)  # fmt: skip
 
 
+def _moving_body(model: ModelDescription, index: int, movers, poses, filters):
+    """``(shapes, mass properties, friction, (group, mask))`` of the world body that body ``index`` and the bodies
+    welded to it make, in its frame."""
+    frame = poses[index]
+    shapes, mass, first = [], None, None
+    for k in (k for k in range(len(model.bodies)) if movers[k] == index):
+        local = _relative(frame, poses[k])
+        for geom in model.bodies[k].geoms:
+            shape = None if (geom.contype, geom.conaffinity) == (0, 0) else _shape(model, geom, True)
+            if shape is not None:
+                shapes.append((shape, *_compose(local, (geom.pos, geom.quat))))
+                first = first or geom
+        mp = model.bodies[k].mass_properties
+        if mp is not None:
+            moved = mp.transformed(rotation=local[1], translation=local[0])
+            mass = moved if mass is None else mass + moved
+    body = model.bodies[index]
+    if mass is None:
+        raise ValueError(f"{model.source}, line {body.line}: body {body.name!r} moves but has no mass")
+    try:
+        require_invertible(mass)
+    except ValueError as error:
+        raise ValueError(f"{model.source}, line {body.line}: body {body.name!r}: {error}") from None
+    if first is None:
+        return shapes, mass, 0.5, (1, 0)
+    return shapes, mass, float(first.friction[0]), filters[(first.contype, first.conaffinity)]
+
+
 def to_world(model: ModelDescription, world=None, position=(0.0, 0.0, 0.0), orientation=_IDENTITY):
     """The model's bodies, joints and geoms in ``world`` (a new one with the model's gravity if None), the whole
     model placed at ``position``/``orientation``; returns the world."""
@@ -140,39 +169,33 @@ def to_world(model: ModelDescription, world=None, position=(0.0, 0.0, 0.0), orie
         parent = place if body.parent < 0 else poses[body.parent]
         poses.append(_compose(parent, (body.pos, body.quat)))
         movers.append(index if body.joints else (-1 if body.parent < 0 else movers[body.parent]))
-    handles: dict[int, object] = {}
-    static_geoms = [(place, geom) for geom in model.world_geoms]
+    # everything worked out and checked before the world changes: a model that cannot be built leaves it as it was
+    planned, static_geoms = [], [(place, geom) for geom in model.world_geoms]
     for index, body in enumerate(model.bodies):
         if movers[index] < 0:
             static_geoms += [(poses[index], geom) for geom in body.geoms]
-            continue
-        if movers[index] != index:
-            continue
-        welded = [k for k in range(len(model.bodies)) if movers[k] == index]
-        frame = poses[index]
-        shapes, mass, first = [], None, None
-        for k in welded:
-            local = _relative(frame, poses[k])
-            for geom in model.bodies[k].geoms:
-                shape = None if (geom.contype, geom.conaffinity) == (0, 0) else _shape(model, geom, True)
-                if shape is not None:
-                    shapes.append((shape, *_compose(local, (geom.pos, geom.quat))))
-                    first = first or geom
-            mp = model.bodies[k].mass_properties
-            if mp is not None:
-                moved = mp.transformed(rotation=local[1], translation=local[0])
-                mass = moved if mass is None else mass + moved
-        if mass is None:
-            raise ValueError(f"{model.source}, line {body.line}: body {body.name!r} moves but has no mass")
-        group, mask = filters[(first.contype, first.conaffinity)] if first is not None else (1, 0)
-        handles[index] = world.add_body(shapes or None, mass_properties=mass, position=frame[0], orientation=frame[1],
-                                        friction=float(first.friction[0]) if first is not None else 0.5,
-                                        collision_group=group, collision_mask=mask, name=body.name)  # fmt: skip
+        elif movers[index] == index:
+            planned.append((index, *_moving_body(model, index, movers, poses, filters)))
+    statics = []
     for pose, geom in static_geoms:
-        if (geom.contype, geom.conaffinity) == (0, 0) or (shape := _shape(model, geom, False)) is None:
-            continue
-        group, mask = filters[(geom.contype, geom.conaffinity)]
-        at = _compose(pose, (geom.pos, geom.quat))
+        if (geom.contype, geom.conaffinity) != (0, 0) and (shape := _shape(model, geom, False)) is not None:
+            statics.append(
+                (shape, _compose(pose, (geom.pos, geom.quat)), geom, filters[(geom.contype, geom.conaffinity)])
+            )
+    names = [model.bodies[index].name for index, *_ in planned] + [geom.name for _, _, geom, _ in statics]
+    taken = {body.name for body in world.bodies if body.name is not None}
+    for name in (name for name in names if name is not None):
+        if name in taken:
+            raise ValueError(f"{model.source}: the name {name!r} is taken in the world (load the model into another "
+                             "world, or rename it there)")  # fmt: skip
+        taken.add(name)
+    handles: dict[int, object] = {}
+    for index, shapes, mass, friction, (group, mask) in planned:
+        frame = poses[index]
+        handles[index] = world.add_body(shapes or None, mass_properties=mass, position=frame[0], orientation=frame[1],
+                                        friction=friction, collision_group=group, collision_mask=mask,
+                                        name=model.bodies[index].name)  # fmt: skip
+    for shape, at, geom, (group, mask) in statics:
         world.add_static(shape, position=at[0], orientation=at[1], friction=float(geom.friction[0]),
                          collision_group=group, collision_mask=mask, name=geom.name)  # fmt: skip
     joints = {}
