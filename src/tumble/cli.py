@@ -586,6 +586,17 @@ def _cmd_info(args) -> int:
         _more(console, len(joints) - table.row_count, "joints")
     else:
         console.print(_text("joints: none"))
+    drives = [] if world._joint_drives is None else world._joint_drives.drives
+    if drives:  # a model file's actuators, driven by world.ctrl
+        table = Table(title=_text(f"actuators ({len(drives)}, world.ctrl)"), title_justify="left")
+        for name in ("#", "name", "joint", "gear", "gain", "bias", "ctrl range"):
+            table.add_column(_text(name))
+        for drive in drives if args.all else drives[:INFO_ROWS]:
+            span = "-" if drive.ctrl_range is None else f"[{_fmt(drive.ctrl_range[0])}, {_fmt(drive.ctrl_range[1])}]"
+            table.add_row(*map(_text, (drive.index, drive.name or "", f"#{drive.joint.index} {drive.joint.kind}",
+                                       _fmt(drive.gear), _fmt(drive.gain), _vec(drive.bias), span)))  # fmt: skip
+        console.print(table)
+        _more(console, len(drives) - table.row_count, "actuators")
 
     run = loaded.run
     settings = Table(title="settings", title_justify="left")

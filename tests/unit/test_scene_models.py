@@ -19,6 +19,7 @@ PENDULUM = """<mujoco model="swing">
     <body name="bob" pos="0 0 1"><joint name="pivot" axis="0 1 0" pos="0 0 0.5" damping="0.1"/>
       <geom type="sphere" size="0.1" pos="0.3 0 0" mass="2"/></body>
   </worldbody>
+  <actuator><motor name="push" joint="pivot" gear="2" ctrlrange="-1 1"/></actuator>
 </mujoco>"""
 
 SCENE = """description = "A model beside a crate"
@@ -93,6 +94,7 @@ def test_tumble_run_and_info_take_a_model_file(folder):
     info = tumble_cli("info", "parts/swing.xml", cwd=folder)
     assert info.returncode == 0, info.stderr
     assert "bob" in info.stdout and "hinge" in info.stdout and "0.005" in info.stdout
+    assert "actuators (1, world.ctrl)" in info.stdout and "push" in info.stdout and "[-1, 1]" in info.stdout
     assert "tumble: " in info.stderr and "joint damping are not simulated" in info.stderr
     assert "Traceback" not in info.stderr and "warn(" not in info.stderr
     run = tumble_cli("run", "parts/swing.xml", "--duration", "0.1", "--out", "swing.h5", "--quiet", cwd=folder)
