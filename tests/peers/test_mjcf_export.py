@@ -27,7 +27,7 @@ WRITTEN = ["box_pile", "dominoes", "dzhanibekov", "newtons_cradle", "pendulum", 
 REFUSED = {
     "flagship": r"body 'bowl' has a TriMesh, which MuJoCo collides as its convex hull",
     "four_bar": r"the hinge joint of 'crank' and None has a motor or spring",
-    "quadrotor_landing": r"the world has vehicles or actuators",
+    "quadrotor_landing": r"the world has vehicles or rotors and thrusters",
 }
 
 

@@ -12,7 +12,9 @@ the present pose, and the present velocities are a keyframe named ``now``
 
 Where the engines differ, the file keeps MuJoCo's meaning: friction is MuJoCo's per geom (MuJoCo takes the larger
 of two geoms', tumble their geometric mean), ``collision_group``/``collision_mask`` become ``contype``/``conaffinity``,
-and what MJCF cannot say is refused with a ``ValueError`` naming it: vehicles and actuators, distance joints,
+and the world's joint actuators (``world.ctrl``) become ``<general>`` actuators on their joints (a driven joint counts
+from its ``ref``, so the actuators' lengths agree; the keyframe holds the controls). What MJCF cannot say is refused
+with a ``ValueError`` naming it: vehicles, rotors and thrusters, distance joints,
 sliders that close a loop, triangle meshes (MuJoCo collides a mesh as its convex hull), joint motors and springs,
 ball-joint cones. Restitution, rolling resistance and body damping have no MJCF counterpart and are left out.
 """
@@ -79,8 +81,8 @@ def _geoms(world, body, name: str, assets: list[str], pose=None) -> str:
 
 
 def _refuse_what_mjcf_cannot_say(world, joints: list[dict]) -> None:
-    if world._vehicles or world.actuators or len(world.ctrl):
-        raise ValueError("to_mjcf: the world has vehicles or actuators, which are not written to MJCF (yet)")
+    if world._vehicles or world.actuators:
+        raise ValueError("to_mjcf: the world has vehicles or rotors and thrusters, which are not written to MJCF (yet)")
     for entry in joints:
         label = f"the {entry['type']} joint of {entry['a']!r} and {entry['b']!r}"
         if entry["type"] == "distance":
@@ -140,8 +142,10 @@ def _velocity(world, i: int, point) -> tuple[np.ndarray, np.ndarray]:
     return np.asarray(body.point_velocity(point), float), np.asarray(body.angular_velocity, float)
 
 
-def _joint_xml(world, child: int, parent: int, entry, qpos: list, qvel: list) -> str:
-    """The child's joint element (and its keyframe coordinates): the present pose is the joint's zero."""
+def _joint_xml(world, child: int, parent: int, entry, qpos: list, qvel: list, driven=None) -> str:
+    """The child's joint element (and its keyframe coordinates): the present pose is the joint's zero, or, for a
+    joint that actuators drive (``driven``: its name, MuJoCo's sense against the world joint's, and its ``ref``),
+    that ``ref``, so that the actuators' lengths are the same in both engines."""
     position, quat = _pose(world, child)
     rotation_t = quat_to_matrix(quat).T
     if entry is None:  # a free root
@@ -161,12 +165,15 @@ def _joint_xml(world, child: int, parent: int, entry, qpos: list, qvel: list) ->
         qvel += list(rotation_t @ (w_child - w_parent))
         return f"<joint type='ball' {local}/>"
     axis = np.asarray(entry["axis"], float)
-    qpos.append(0.0)
+    name, sense, ref = driven if driven is not None else (None, 1.0, 0.0)
+    qpos.append(ref)
     qvel.append(float(axis @ ((w_child - w_parent) if kind == "hinge" else (v_child - v_parent))))
     bounds = ""
     if "lower" in entry or "upper" in entry:
-        bounds = f" range='{_num([entry.get('lower', -1e10), entry.get('upper', 1e10)])}'"
-    return f"<joint type='{kind}' {local} axis='{_num(rotation_t @ axis)}'{bounds}/>"
+        low, high = sorted(ref + sense * np.array([entry.get("lower", -1e10), entry.get("upper", 1e10)]))
+        bounds = f" range='{_num([low, high])}'"
+    named = "" if name is None else f" name={quoteattr(name)} ref='{_num([ref])}'"
+    return f"<joint type='{kind}'{named} {local} axis='{_num(rotation_t @ axis)}'{bounds}/>"
 
 
 def _loop_xml(world, entry, index: dict[str, int]) -> str:
@@ -187,12 +194,50 @@ def _loop_xml(world, entry, index: dict[str, int]) -> str:
                      "equality constraints cannot hold")  # fmt: skip
 
 
+def _driven_joints(world, via: dict, names: list[str]) -> dict[int, tuple[str, float, float]]:
+    """For each world joint that actuators drive: its MJCF name, MuJoCo's sense against the world joint's (-1 where
+    the tree hangs the joint's first body from its second) and its ``ref``."""
+    drives = [] if world._joint_drives is None else world._joint_drives.drives
+    out = {}
+    for drive in drives:
+        k = drive.joint.index
+        spec = world._builder.joints[k]
+        entry_child = next((c for c, e in via.items() if e is not None and e.get("_index") == k), None)
+        if entry_child is None:
+            raise ValueError(f"to_mjcf: actuator {drive.index} drives a joint that closes a loop, which MJCF's "
+                             "equality constraints cannot carry")  # fmt: skip
+        sense = 1.0 if entry_child == spec.body_b else -1.0
+        coordinate = drive.joint.angle if drive.joint.kind == "hinge" else drive.joint.translation
+        ref = sense * (drive.ref + coordinate)
+        if k in out and abs(out[k][2] - ref) > 0.0:
+            raise ValueError(f"to_mjcf: the actuators on joint {k} count its coordinate from different refs")
+        out[k] = (f"{names[entry_child]}/joint", sense, ref)
+    return out
+
+
+def _actuators_xml(world, driven: dict) -> str:
+    """Each joint actuator as a ``<general>`` on its joint (the gear carries MuJoCo's sense)."""
+    out = []
+    for drive in [] if world._joint_drives is None else world._joint_drives.drives:
+        name, sense, _ = driven[drive.joint.index]
+        label = "" if drive.name is None else f" name={quoteattr(drive.name)}"
+        limits = "ctrllimited='false'" if drive.ctrl_range is None else f"ctrlrange='{_num(drive.ctrl_range)}'"
+        out.append(
+            f"<general{label} joint={quoteattr(name)} gear='{_num([sense * drive.gear])}' "
+            f"gainprm='{_num([drive.gain])}' biastype='affine' biasprm='{_num(drive.bias)}' {limits}/>"
+        )
+    return "".join(out)
+
+
 def world_to_mjcf(world, *, timestep: float | None = None, model: str = "tumble") -> str:
     """The MJCF text of ``world`` now (module docstring); ``timestep`` [s] goes into ``<option>`` if given."""
     names = body_names(world)
     joints = [joint_entry(joint, names) for joint in world.joints]
     _refuse_what_mjcf_cannot_say(world, joints)
+    for k, entry in enumerate(joints):
+        entry["_index"] = k
     parent, via, loops = _tree(world, joints)
+    driven = _driven_joints(world, via, names)
     children: dict[int, list[int]] = {}
     for child, p in parent.items():
         children.setdefault(p, []).append(child)
@@ -208,7 +253,10 @@ def world_to_mjcf(world, *, timestep: float | None = None, model: str = "tumble"
         mp = world._builder.rows[i].mass_properties
         inertia = mp.inertia
         full = [inertia[0, 0], inertia[1, 1], inertia[2, 2], inertia[0, 1], inertia[0, 2], inertia[1, 2]]
-        joint = _joint_xml(world, i, parent[i], via[i], qpos, qvel)
+        entry = via[i]
+        joint = _joint_xml(
+            world, i, parent[i], entry, qpos, qvel, None if entry is None else driven.get(entry["_index"])
+        )
         inner = "".join(body_xml(c) for c in children.get(i, []))
         return (f"<body name={quoteattr(names[i])} pos='{_num(local_position)}' quat='{_num(local_quat)}'>{joint}"
                 f"<inertial pos='{_num(mp.com)}' mass='{_num([mp.mass])}' fullinertia='{_num(full)}'/>"
@@ -220,9 +268,12 @@ def world_to_mjcf(world, *, timestep: float | None = None, model: str = "tumble"
     index = {name: i for i, name in enumerate(names)}
     equality = "".join(_loop_xml(world, joints[k], index) for k in loops)
     option = f"<option gravity='{_num(world.gravity)}'" + (f" timestep='{_num([timestep])}'/>" if timestep else "/>")
-    keyframe = f"<keyframe><key name='now' qpos='{_num(qpos)}' qvel='{_num(qvel)}'/></keyframe>" if qpos else ""
+    ctrl = f" ctrl='{_num(world.ctrl)}'" if len(world.ctrl) else ""
+    keyframe = f"<keyframe><key name='now' qpos='{_num(qpos)}' qvel='{_num(qvel)}'{ctrl}/></keyframe>" if qpos else ""
+    actuators = _actuators_xml(world, driven)
     return (f"<mujoco model={quoteattr(model)}><compiler angle='radian' autolimits='true'/>{option}"
             + (f"<asset>{''.join(assets)}</asset>" if assets else "")
             + f"<worldbody>{statics}{bodies}</worldbody>"
             + (f"<equality>{equality}</equality>" if equality else "")
+            + (f"<actuator>{actuators}</actuator>" if actuators else "")
             + f"{keyframe}</mujoco>")  # fmt: skip
