@@ -10,19 +10,21 @@ from .xml import Node
 __all__ = ["flag", "keyword", "number", "numbers"]
 
 
-def numbers(node: Node, attrib: dict[str, str], name: str, count: int | tuple[int, ...], default=None):
-    """The numbers of ``attrib[name]`` (``count`` of them, or one of the counts), else ``default`` (or None)."""
+def numbers(node: Node, attrib: dict[str, str], name: str, count: int | tuple[int, ...] | None, default=None):
+    """The finite numbers of ``attrib[name]`` (``count`` of them, one of the counts, or any number for None), else
+    ``default`` (or None)."""
     text = attrib.get(name)
     if text is None:
         return None if default is None else np.array(default, dtype=float)
+    shown = repr(text if len(text) <= 40 else text[:37] + "...")  # a mesh's vertex list is long
     try:
         values = np.array([float(word) for word in text.split()], dtype=float)
     except ValueError:
-        raise node.error(f"{name}={text!r} is not a list of numbers") from None
+        raise node.error(f"{name}={shown} is not a list of numbers") from None
     counts = (count,) if isinstance(count, int) else count
-    if values.size not in counts or not np.all(np.isfinite(values)):
-        wanted = " or ".join(str(c) for c in counts)
-        raise node.error(f"{name}={text!r} must be {wanted} finite numbers")
+    if (counts is not None and values.size not in counts) or not np.all(np.isfinite(values)):
+        wanted = "" if counts is None else " or ".join(str(c) for c in counts) + " "
+        raise node.error(f"{name}={shown} must be {wanted}finite numbers")
     return values
 
 

@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from ..description import MeshDescription
+from .attributes import numbers
 from .mesh_inertia import convex_hull_faces
 from .xml import Node
 
@@ -74,20 +75,10 @@ def _file_path(node: Node, name: str, directory: Path, strip: bool) -> Path:
     return path
 
 
-def _numbers(node: Node, attrib: dict[str, str], name: str) -> np.ndarray | None:
-    text = attrib.get(name)
-    if text is None:
-        return None
-    try:
-        return np.array([float(word) for word in text.split()], dtype=float)
-    except ValueError:
-        raise node.error(f"{name}={text[:40]!r} is not a list of numbers") from None
-
-
 def _written(node: Node, attrib: dict[str, str]) -> tuple[np.ndarray, np.ndarray | None]:
     """Vertices and faces written in the model."""
-    values = _numbers(node, attrib, "vertex")
-    if values.size < 12 or values.size % 3 or not np.all(np.isfinite(values)):
+    values = numbers(node, attrib, "vertex", None)
+    if values.size < 12 or values.size % 3:
         raise node.error(f"vertex holds {values.size} numbers: at least four vertices, three finite numbers each")
     vertices = values.reshape(-1, 3)
     text = attrib.get("face")
@@ -123,10 +114,7 @@ def read_mesh(node: Node, attrib: dict[str, str], directory: Path, strip: bool) 
         if not name:
             raise node.error("a mesh written in the model needs a name")
     vertices = vertices.astype(np.float32).astype(np.float64)
-    refpos, scale = _numbers(node, attrib, "refpos"), _numbers(node, attrib, "scale")
-    for label, value in (("refpos", refpos), ("scale", scale)):
-        if value is not None and (value.size != 3 or not np.all(np.isfinite(value))):
-            raise node.error(f"{label}={attrib[label]!r} must be 3 finite numbers")
+    refpos, scale = numbers(node, attrib, "refpos", 3), numbers(node, attrib, "scale", 3)
     if refpos is not None:
         vertices = vertices - refpos
     if scale is not None:
