@@ -155,3 +155,25 @@ def test_load_mjcf_of_to_mjcf_rebuilds_the_world_and_its_motion(name):
     for body in rebuilt.bodies:
         if not body.is_static:
             np.testing.assert_allclose(body.position, _same_moved[body.name], rtol=0, atol=1e-9)
+
+
+def test_a_chain_deeper_than_the_recursion_limit_is_written():
+    """The body tree is written from a stack of its own: a chain of 300 links under a recursion limit of 200 (as a
+    chain of thousands under Python's 1000) loads in MuJoCo with its last link where the world has it."""
+    import sys
+
+    world = tumble.World()
+    parent = None
+    for i in range(300):
+        body = world.add_body(tumble.Sphere(0.01), mass=0.1, position=(0.02 * i, 0.0, 1.0), name=f"link{i}")
+        world.add_joint(tumble.HingeJoint(body, parent, (0.02 * i - 0.01, 0.0, 1.0), (0.0, 1.0, 0.0)))
+        parent = body
+    limit = sys.getrecursionlimit()
+    sys.setrecursionlimit(200)
+    try:
+        xml = world.to_mjcf()
+    finally:
+        sys.setrecursionlimit(limit)
+    model, data = mujoco_now(xml)
+    assert model.nbody == 301 and model.njnt == 300
+    np.testing.assert_allclose(data.xpos[model.body("link299").id], (0.02 * 299, 0.0, 1.0), atol=1e-12)

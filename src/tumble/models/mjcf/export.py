@@ -245,7 +245,8 @@ def world_to_mjcf(world, *, timestep: float | None = None, model: str = "tumble"
     qpos: list[float] = []
     qvel: list[float] = []
 
-    def body_xml(i: int) -> str:
+    def body_open(i: int) -> str:
+        """A body's opening tag, joint, inertial and geoms; its children and ``</body>`` follow."""
         position, quat = _pose(world, i)
         parent_position, parent_quat = _pose(world, parent[i])
         inverse = quat_conjugate(parent_quat)
@@ -254,17 +255,26 @@ def world_to_mjcf(world, *, timestep: float | None = None, model: str = "tumble"
         inertia = mp.inertia
         full = [inertia[0, 0], inertia[1, 1], inertia[2, 2], inertia[0, 1], inertia[0, 2], inertia[1, 2]]
         entry = via[i]
-        joint = _joint_xml(
-            world, i, parent[i], entry, qpos, qvel, None if entry is None else driven.get(entry["_index"])
-        )
-        inner = "".join(body_xml(c) for c in children.get(i, []))
+        drive = None if entry is None else driven.get(entry["_index"])
+        joint = _joint_xml(world, i, parent[i], entry, qpos, qvel, drive)
         return (f"<body name={quoteattr(names[i])} pos='{_num(local_position)}' quat='{_num(local_quat)}'>{joint}"
                 f"<inertial pos='{_num(mp.com)}' mass='{_num([mp.mass])}' fullinertia='{_num(full)}'/>"
-                f"{_geoms(world, world.bodies[i], names[i], assets)}{inner}</body>")  # fmt: skip
+                f"{_geoms(world, world.bodies[i], names[i], assets)}")  # fmt: skip
 
     statics = "".join(_geoms(world, b, names[b.index], assets, pose=_pose(world, b.index))
                       for b in world.bodies if b.is_static)  # fmt: skip
-    bodies = "".join(body_xml(i) for i in children.get(_WORLD, []))
+    # depth first, parents before children (MuJoCo's joint order, the keyframe's), on a stack of its own: a chain of
+    # a thousand links is past Python's recursion limit
+    parts, stack = [], [(i, False) for i in reversed(children.get(_WORLD, []))]
+    while stack:
+        i, close = stack.pop()
+        if close:
+            parts.append("</body>")
+            continue
+        parts.append(body_open(i))
+        stack.append((i, True))
+        stack.extend((c, False) for c in reversed(children.get(i, [])))
+    bodies = "".join(parts)
     index = {name: i for i, name in enumerate(names)}
     equality = "".join(_loop_xml(world, joints[k], index) for k in loops)
     option = f"<option gravity='{_num(world.gravity)}'" + (f" timestep='{_num([timestep])}'/>" if timestep else "/>")
