@@ -198,11 +198,12 @@ def _driven_joints(world, via: dict, names: list[str]) -> dict[int, tuple[str, f
     """For each world joint that actuators drive: its MJCF name, MuJoCo's sense against the world joint's (-1 where
     the tree hangs the joint's first body from its second) and its ``ref``."""
     drives = [] if world._joint_drives is None else world._joint_drives.drives
+    child_of = {entry["_index"]: child for child, entry in via.items() if entry is not None}  # joint -> its child
     out = {}
     for drive in drives:
         k = drive.joint.index
         spec = world._builder.joints[k]
-        entry_child = next((c for c, e in via.items() if e is not None and e.get("_index") == k), None)
+        entry_child = child_of.get(k)
         if entry_child is None:
             raise ValueError(f"to_mjcf: actuator {drive.index} drives a joint that closes a loop, which MJCF's "
                              "equality constraints cannot carry")  # fmt: skip
