@@ -26,13 +26,22 @@ CHROMIUM = "/usr/bin/chromium"
 CHROMIUM_ARGS = ["--headless", "--no-sandbox", "--use-angle=swiftshader", "--enable-unsafe-swiftshader"]
 BACKGROUND = np.array([223, 228, 234])  # the clear colour (0.875, 0.894, 0.918)
 
-COUNT_FRAMES = """() => new Promise((resolve) => {
+# page.evaluate waits on a promise without a time limit: each one that waits on animation frames gives up after 30 s
+# with an error instead of hanging the test run if the page stops drawing.
+COUNT_FRAMES = """() => new Promise((resolve, reject) => {
   let n = 0; const start = performance.now();
+  const late = setTimeout(() => reject(new Error("no animation frames for 30 s")), 30000);
   function tick(now) {
     n++;
-    if (now - start < 2000) requestAnimationFrame(tick); else resolve(1000 * n / (now - start));
+    if (now - start < 2000) requestAnimationFrame(tick);
+    else { clearTimeout(late); resolve(1000 * n / (now - start)); }
   }
   requestAnimationFrame(tick);
+})"""
+
+NEXT_FRAMES = """() => new Promise((resolve, reject) => {
+  const late = setTimeout(() => reject(new Error("no animation frame for 30 s")), 30000);
+  requestAnimationFrame(() => requestAnimationFrame(() => { clearTimeout(late); resolve(); }));
 })"""
 
 FIND_PICKABLE = """() => {
@@ -64,6 +73,16 @@ def browser():
         chromium = playwright.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS)
         yield chromium
         chromium.close()
+
+
+@pytest.fixture(autouse=True)
+def close_pages(request):
+    """Each test's pages are closed after it: pages left open (some still animating) would share the one browser's
+    time with the next tests."""
+    yield
+    if "browser" in request.fixturenames:
+        for context in request.getfixturevalue("browser").contexts:
+            context.close()
 
 
 @pytest.fixture(scope="module")
@@ -100,7 +119,7 @@ def open_replay(browser, path: Path, *, width: int = 1000, height: int = 720, in
 
 def next_frames(page) -> None:
     """Wait until the page has drawn what the last input asked for (it redraws on animation frames)."""
-    page.evaluate("() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r)))")
+    page.evaluate(NEXT_FRAMES)
 
 
 def canvas_pixels(page, element: str = "scene") -> np.ndarray:
