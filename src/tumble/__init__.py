@@ -15,7 +15,7 @@ __version__ = "0.1.0"
 from . import actuators, control, mass, rotation, sensors, shapes, vehicles, wind
 from .errors import SimulationError
 from .handles import Body, Joint
-from .joints import BallJoint, DistanceJoint, FixedJoint, HingeJoint, SliderJoint
+from .joints import BallJoint, DistanceJoint, FixedJoint, HingeJoint, PlanarJoint, SliderJoint, UniversalJoint
 from .mass import MassProperties
 from .shapes import Box, Capsule, ConvexHull, Cylinder, Plane, Shape, ShapeType, Sphere, TriMesh
 from .trajectory import Trajectory
@@ -66,6 +66,7 @@ __all__ = [
     "Joint",
     "MassProperties",
     "Plane",
+    "PlanarJoint",
     "Prismatic",
     "Revolute",
     "Shape",
@@ -75,6 +76,7 @@ __all__ = [
     "Sphere",
     "Trajectory",
     "TriMesh",
+    "UniversalJoint",
     "World",
     "__version__",
     "actuators",

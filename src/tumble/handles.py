@@ -314,7 +314,7 @@ class Joint:
 
     @property
     def kind(self) -> str:
-        """``"ball"``, ``"hinge"``, ``"slider"``, ``"fixed"`` or ``"distance"``."""
+        """``"ball"``, ``"hinge"``, ``"slider"``, ``"fixed"``, ``"distance"``, ``"planar"`` or ``"universal"``."""
         return JointKind(self._spec().kind).name.lower()
 
     @property
@@ -408,9 +408,12 @@ class Joint:
 
     @property
     def position_error(self) -> float:
-        """How far the joint is from holding [m]: the gap between the anchors (ball, hinge, fixed), its part
-        across the axis (slider), or how far the length lies outside ``[min_length, max_length]`` (distance)."""
+        """How far the joint is from holding [m]: the gap between the anchors (ball, hinge, fixed, universal), its
+        part across the axis (slider) or along the normal (planar), or how far the length lies outside
+        ``[min_length, max_length]`` (distance)."""
         value, _, gap, _, _ = self._coordinates()
+        if self.kind == "planar":
+            return float(abs(value))
         if self.kind == "slider":
             return float(np.sqrt(max(gap**2 - value**2, 0.0)))
         if self.kind == "distance":
@@ -420,7 +423,8 @@ class Joint:
 
     @property
     def angular_error(self) -> float:
-        """Misalignment [rad]: hinge axes apart, or the relative rotation of a fixed or slider joint; 0 else."""
+        """Misalignment [rad]: hinge axes (planar normals) apart, a universal joint's axes off perpendicular, or the
+        relative rotation of a fixed or slider joint; 0 else."""
         return float(self._coordinates()[3])
 
     @property

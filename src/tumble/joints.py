@@ -18,6 +18,10 @@ Optional parts of a hinge or slider, each off unless given:
 
 A :class:`DistanceJoint` keeps two anchors at ``length`` (a rigid rod), or, with ``spring_hertz > 0``, pulls
 them towards it as a damped spring, and ``min_length``/``max_length`` bound it (a rope: ``min_length=0``).
+
+A :class:`PlanarJoint` keeps ``b`` moving in a plane of ``a`` (two translations and the turn about the normal: the
+root of MuJoCo's 2-D walkers); a :class:`UniversalJoint` is a Hooke's joint (a common point, two perpendicular
+axes, one carried by each body). Neither has limits, motors or springs.
 """
 
 from __future__ import annotations
@@ -39,7 +43,9 @@ __all__ = [
     "FixedJoint",
     "HingeJoint",
     "JointKind",
+    "PlanarJoint",
     "SliderJoint",
+    "UniversalJoint",
 ]
 
 
@@ -257,7 +263,50 @@ class DistanceJoint(_JointBase):
         return self.drive.spring_target
 
 
-JOINT_TYPES = (BallJoint, HingeJoint, SliderJoint, FixedJoint, DistanceJoint)
+class PlanarJoint(_JointBase):
+    """``b`` slides in a plane of ``a`` and turns only about its normal (3 freedoms): the root of a planar walker,
+    a puck on a table.
+
+    Args:
+        a, b: bodies (``b=None``: the world). normal: (3,) non-zero, world frame at creation.
+        anchor: (3,) a point of the plane [m] (default: ``b``'s origin, or ``a``'s when ``b`` is None).
+    """
+
+    kind = JointKind.PLANAR
+
+    def __init__(self, a, b, normal, *, anchor=None, collide_connected: bool = False):
+        self._set_bodies(a, b, collide_connected)
+        self._set("anchor", None if anchor is None else as_vector3("anchor", anchor))
+        self._set("normal", as_unit_vector3("normal", normal))
+        self._set("drive", _NO_DRIVE)
+
+
+class UniversalJoint(_JointBase):
+    """A Hooke's joint (2 rotational freedoms): a common point, ``b`` turning about ``axis_a`` (carried by ``a``)
+    and about ``axis_b`` (carried by ``b``), which stay perpendicular: a cardan shaft, a two-hinge shoulder.
+
+    Args:
+        a, b: bodies (``b=None``: the world). anchor: (3,) the common point [m], world frame at creation.
+        axis_a, axis_b: (3,) perpendicular (within 1e-6 rad), world frame at creation.
+    """
+
+    kind = JointKind.UNIVERSAL
+
+    def __init__(self, a, b, anchor, axis_a, axis_b, *, collide_connected: bool = False):
+        self._set_bodies(a, b, collide_connected)
+        self._set("anchor", as_vector3("anchor", anchor))
+        axis_a, axis_b = as_unit_vector3("axis_a", axis_a), as_unit_vector3("axis_b", axis_b)
+        if abs(float(axis_a @ axis_b)) > 1e-6:
+            raise ValueError(
+                f"axis_a and axis_b must be perpendicular (a Hooke's joint), got {axis_a.tolist()} and "
+                f"{axis_b.tolist()} at {math.degrees(math.acos(min(abs(float(axis_a @ axis_b)), 1.0))):.6g}°"
+            )
+        self._set("axis_a", axis_a)
+        self._set("axis_b", axis_b)
+        self._set("drive", _NO_DRIVE)
+
+
+JOINT_TYPES = (BallJoint, HingeJoint, SliderJoint, FixedJoint, DistanceJoint, PlanarJoint, UniversalJoint)
 
 
 def _world_pose(world, body) -> tuple[np.ndarray, np.ndarray]:
@@ -302,11 +351,19 @@ def joint_spec(joint, world) -> JointSpec:
             f"{'the world' if b is None else repr(b.name or b.index)} is {'fixed' if b is None else 'static'}"
         )
     anchor = joint.anchor
-    if anchor is None:  # slider and fixed joints: b's origin, or a's when b is the world
+    if anchor is None:  # slider, fixed and planar joints: b's origin, or a's when b is the world
         anchor = (b if b is not None else a).position
     anchor_b = getattr(joint, "anchor_b", anchor)
-    axis = getattr(joint, "axis", None)
-    frame = _frame_with_x_along(axis) if axis is not None else np.array([1.0, 0.0, 0.0, 0.0])
+    axis = getattr(joint, "normal", getattr(joint, "axis", None))
+    if isinstance(joint, UniversalJoint):
+        # The solver's body a carries the frame's x axis, its body b the y axis (made exactly perpendicular); joined
+        # to the world, the world takes a's place (below) and carries axis_b.
+        x, y = (joint.axis_a, joint.axis_b) if b is not None else (joint.axis_b, joint.axis_a)
+        y = y - (y @ x) * x
+        y /= np.linalg.norm(y)
+        frame = matrix_to_quat(np.column_stack([x, y, np.cross(x, y)]))
+    else:
+        frame = _frame_with_x_along(axis) if axis is not None else np.array([1.0, 0.0, 0.0, 0.0])
     if b is None:
         # Joined to the world: the world takes a's place in the solver (body -1), so that the angle or translation
         # is that of the body relative to the world, as a user reads it.

@@ -177,3 +177,53 @@ def test_a_chain_deeper_than_the_recursion_limit_is_written():
     model, data = mujoco_now(xml)
     assert model.nbody == 301 and model.njnt == 300
     np.testing.assert_allclose(data.xpos[model.body("link299").id], (0.02 * 299, 0.0, 1.0), atol=1e-12)
+
+
+def _walker() -> tumble.World:
+    """A box on a planar joint to the world with two legs hung from it by universal joints, each side of the joint
+    first (the tree hangs the first leg's joint from its second body), all moving."""
+    world = tumble.World(gravity=(0.0, 0.0, -9.81))
+    hip = world.add_body(tumble.Box((0.4, 0.2, 0.1)), mass=1.0, position=(0, 0, 1), orientation=(0.9, 0.1, 0.3, 0.2),
+                         name="hip")  # fmt: skip
+    world.add_joint(tumble.PlanarJoint(hip, None, (0.0, 0.6, 0.8)))
+    right = world.add_body(tumble.Box((0.1, 0.1, 0.5)), mass=1.0, position=(0.3, 0, 0.6), name="right")
+    world.add_joint(tumble.UniversalJoint(right, hip, (0.3, 0, 0.85), (1, 0, 0), (0, 1, 0)))
+    left = world.add_body(tumble.Box((0.1, 0.1, 0.5)), mass=1.0, position=(-0.3, 0, 0.6), name="left")
+    world.add_joint(tumble.UniversalJoint(hip, left, (-0.3, 0, 0.85), (0, 1, 0), (1, 0, 0)))
+    hip.velocity, hip.angular_velocity, right.angular_velocity = (0.3, 0.2, 0.1), (0.2, 0.1, 1.0), (1.0, 0.5, 0.3)
+    world.simulate(0.2, 1 / 1000)
+    return world
+
+
+def test_planar_and_universal_joints_are_written_as_mujocos_joints_and_read_back():
+    """A planar joint is two slides and a hinge, a universal joint two hinges with the parent's axis first: MuJoCo
+    puts every body where it is and moves it as it moves; load_mjcf makes the same joints again."""
+    world = _walker()
+    xml = world.to_mjcf(timestep=0.001)
+    model, data = mujoco_now(xml)
+    assert list(model.jnt_type) == [mujoco.mjtJoint.mjJNT_SLIDE] * 2 + [mujoco.mjtJoint.mjJNT_HINGE] * 5
+    for body in world.bodies:
+        i = model.body(body.name).id
+        np.testing.assert_allclose(data.xpos[i], body.position, rtol=0, atol=1e-12)
+        assert abs(abs(np.dot(data.xquat[i], body.orientation)) - 1.0) < 1e-12
+        velocity = np.zeros(6)
+        mujoco.mj_objectVelocity(model, data, mujoco.mjtObj.mjOBJ_BODY, i, velocity, 0)
+        # MuJoCo's velocities are exactly jointed; tumble's soft joints leave 4e-4 rad/s across the planar normal
+        np.testing.assert_allclose(velocity[:3], body.angular_velocity, rtol=0, atol=2e-3)
+        np.testing.assert_allclose(velocity[3:], body.velocity, rtol=0, atol=2e-3)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", MJCFWarning)  # the keyframe
+        rebuilt = tumble.load_mjcf(xml)
+    assert [j.kind for j in rebuilt.joints] == ["planar", "universal", "universal"]
+    _same_bodies(world, rebuilt)
+
+
+def test_planar_and_universal_joints_go_through_a_scene_file(tmp_path):
+    world = _walker()
+    (tmp_path / "walker.toml").write_text(tumble.scene_file.dumps(world.to_scene()), encoding="utf-8")
+    copy = tumble.scene_file.load(tmp_path / "walker.toml").world
+    assert [j.kind for j in copy.joints] == ["planar", "universal", "universal"]
+    for w in (world, copy):
+        w.simulate(0.5, 1 / 1000)
+    for body, other in zip(world.bodies, copy.bodies, strict=True):
+        np.testing.assert_allclose(other.position, body.position, rtol=0, atol=1e-5)  # warm starts are not saved

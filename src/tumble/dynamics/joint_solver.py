@@ -1,4 +1,5 @@
-"""Joint solver: ball, hinge, slider, fixed and distance joints as soft constraints in the substeps.
+"""Joint solver: ball, hinge, slider, fixed, distance, planar and universal joints as soft constraints in the
+substeps.
 
 Joints are solved with the contacts in the soft step (E. Catto, "Solver2D", 2024; Box2D v3's joints): every
 substep re-applies the joints' accumulated impulses (warm start), solves each joint once with a soft position
@@ -20,7 +21,12 @@ is ``Ċ = l·(v_b − v_a) − α·ω_a + β·ω_b`` with effective mass ``K_rs 
 - angular lock (fixed, slider): ``l = 0``, ``α = β`` the world axes, error the rotation vector of
   ``q_b f_b (q_a f_a)⁻¹``; hinge alignment: the two of those across the axis, error ``n_a × n_b``;
 - slider: the anchor rows across the axis and the drive along it use ``a``'s arm ``r_a + d`` (the axis turns
-  with ``a``: ``d/dt (d·n) = (v_b + ω_b × r_b − v_a − ω_a × (r_a + d))·n``).
+  with ``a``: ``d/dt (d·n) = (v_b + ω_b × r_b − v_a − ω_a × (r_a + d))·n``);
+- planar (``n`` the plane's normal, the frame's x axis): one linear row along ``n`` with the slider's arm, and the
+  hinge's two alignment rows (``b`` turns only about ``n``);
+- universal (Hooke's joint: ``n_a`` the frame's x axis carried by ``a``, ``m_b`` its y axis carried by ``b``,
+  perpendicular at creation): the anchor rows and one angular row keeping them perpendicular, ``C = n_a·m_b``,
+  ``Ċ = (m_b × n_a)·(ω_b − ω_a)``.
 
 Impulses live in ``state.joint_*`` (for warm starting and bit-identical resume): the point or cross-axis linear
 impulse and the angular impulse as world vectors, and four drive impulses (spring, motor, lower, upper).
@@ -59,7 +65,7 @@ from .softness import soft_coefficients
 
 __all__ = ["JointArrays", "JointKind", "joint_coordinates", "solve_joints", "warm_start_joints"]
 
-BALL, HINGE, SLIDER, FIXED, DISTANCE = 0, 1, 2, 3, 4  # joint kinds, as plain ints for the kernels
+BALL, HINGE, SLIDER, FIXED, DISTANCE, PLANAR, UNIVERSAL = 0, 1, 2, 3, 4, 5, 6  # joint kinds, plain ints for kernels
 
 
 class JointKind(IntEnum):
@@ -70,6 +76,8 @@ class JointKind(IntEnum):
     SLIDER = SLIDER
     FIXED = FIXED
     DISTANCE = DISTANCE
+    PLANAR = PLANAR
+    UNIVERSAL = UNIVERSAL
 
 
 # Columns of JointArrays.drive
@@ -139,8 +147,9 @@ def _frames(joints, j, xa, qa, xb, qb):
 
 @inline
 def _arm_a(kind, ra, d):
-    """``a``'s lever arm for linear rows: the slider's axis turns with ``a`` about the point ``x_a + r_a + d``."""
-    return add(ra, d) if kind == SLIDER else ra
+    """``a``'s lever arm for linear rows: a slider's axis (a plane's normal) turns with ``a`` about the point
+    ``x_a + r_a + d``."""
+    return add(ra, d) if kind == SLIDER or kind == PLANAR else ra
 
 
 @inline
@@ -235,7 +244,7 @@ def _block_rows(kind, fa, fb, arm, rb, d, dir_l, dir_a, dir_b, error):
     (``l = 0``, ``α = β`` the axis). Returns ``(rows, linear rows)``."""
     zero = (0.0, 0.0, 0.0)
     rows = 0
-    if kind == BALL or kind == HINGE or kind == FIXED:
+    if kind == BALL or kind == HINGE or kind == FIXED or kind == UNIVERSAL:
         _set_row(0, _EX, cross(arm, _EX), cross(rb, _EX), d[0], dir_l, dir_a, dir_b, error)
         _set_row(1, _EY, cross(arm, _EY), cross(rb, _EY), d[1], dir_l, dir_a, dir_b, error)
         _set_row(2, _EZ, cross(arm, _EZ), cross(rb, _EZ), d[2], dir_l, dir_a, dir_b, error)
@@ -245,8 +254,12 @@ def _block_rows(kind, fa, fb, arm, rb, d, dir_l, dir_a, dir_b, error):
         _set_row(0, y, cross(arm, y), cross(rb, y), dot(d, y), dir_l, dir_a, dir_b, error)
         _set_row(1, z, cross(arm, z), cross(rb, z), dot(d, z), dir_l, dir_a, dir_b, error)
         rows = 2
+    elif kind == PLANAR:
+        n = quat_rotate(fa, _EX)
+        _set_row(0, n, cross(arm, n), cross(rb, n), dot(d, n), dir_l, dir_a, dir_b, error)
+        rows = 1
     linear_rows = rows
-    if kind == HINGE:
+    if kind == HINGE or kind == PLANAR:
         y, z = quat_rotate(fa, _EY), quat_rotate(fa, _EZ)
         err = cross(quat_rotate(fa, _EX), quat_rotate(fb, _EX))
         _set_row(rows, zero, y, y, dot(err, y), dir_l, dir_a, dir_b, error)
@@ -259,6 +272,11 @@ def _block_rows(kind, fa, fb, arm, rb, d, dir_l, dir_a, dir_b, error):
         _set_row(rows + 1, zero, _EY, _EY, sign * q_err[2], dir_l, dir_a, dir_b, error)
         _set_row(rows + 2, zero, _EZ, _EZ, sign * q_err[3], dir_l, dir_a, dir_b, error)
         rows += 3
+    elif kind == UNIVERSAL:
+        n_a, m_b = quat_rotate(fa, _EX), quat_rotate(fb, _EY)
+        t = cross(m_b, n_a)
+        _set_row(rows, zero, t, t, dot(n_a, m_b), dir_l, dir_a, dir_b, error)
+        rows += 1
     return rows, linear_rows
 
 
@@ -565,9 +583,11 @@ def joint_coordinates(joints, pos, quat, linvel, angvel, first, stop, out):
         out[j - first, 1] = _axial_rate(kind == HINGE or kind == BALL, n, arm, rb, va, wa, vb, wb)
         out[j - first, 4] = _swing(fa, fb)[0] if kind == BALL else 0.0
         out[j - first, 2] = math.sqrt(dot(d, d))
-        if kind == HINGE:
+        if kind == HINGE or kind == PLANAR:
             na, nb = quat_rotate(fa, _EX), quat_rotate(fb, _EX)
             out[j - first, 3] = math.atan2(math.sqrt(dot(cross(na, nb), cross(na, nb))), dot(na, nb))
+        elif kind == UNIVERSAL:
+            out[j - first, 3] = abs(math.asin(min(max(dot(quat_rotate(fa, _EX), quat_rotate(fb, _EY)), -1.0), 1.0)))
         elif kind == FIXED or kind == SLIDER:
             q_err = quat_mul(fb, quat_conj(fa))
             sine = math.sqrt(q_err[1] ** 2 + q_err[2] ** 2 + q_err[3] ** 2)

@@ -5,12 +5,17 @@ Every body with a joint becomes a world body at its pose in the model (MuJoCo's 
 mass of the jointless bodies welded to it; bodies welded to the world are static geometry with the world's own
 geoms. A hinge, slide or ball joint to the parent becomes a :class:`~tumble.HingeJoint`,
 :class:`~tumble.SliderJoint` or :class:`~tumble.BallJoint` (a hinge's or slide's ``range`` its limits); a free joint
-leaves the body free. A world joint joins two bodies with one joint, so a body with several joints is refused
-(``tumble.articulation.from_mjcf`` loads it). Geoms become shapes (a mesh its convex hull, as MuJoCo collides it; an
-ellipsoid the hull of 162 points on it); geoms that collide with nothing (``contype = conaffinity = 0``) are left
-out. MuJoCo lets two geoms touch when ``contype₁ & conaffinity₂`` or ``contype₂ & conaffinity₁``; tumble's filter
-asks both of ``group₁ & mask₂`` and ``group₂ & mask₁``, so each distinct pair ``(contype, conaffinity)`` gets a bit
-of its own as its group, and its mask holds the bits of the pairs it touches: the same pairs collide.
+leaves the body free. Several joints of one body become the one world joint that moves the body as they do: two
+hinges through one point with perpendicular axes a :class:`~tumble.UniversalJoint` (the first axis carried by the
+parent, the second by the body, as MuJoCo composes them), three hinges through one point with independent axes a
+:class:`~tumble.BallJoint`, two slides and a hinge normal to both a :class:`~tumble.PlanarJoint` (the root of
+the 2-D walkers); their ranges and actuators are left out with a warning. Any other set is refused
+(``tumble.articulation.from_mjcf`` loads every model). Geoms become shapes (a mesh its convex hull, as MuJoCo
+collides it; an ellipsoid the hull of 162 points on it); geoms that collide with nothing (``contype = conaffinity =
+0``) are left out. MuJoCo lets two geoms touch when ``contype₁ & conaffinity₂`` or ``contype₂ & conaffinity₁``;
+tumble's filter asks both of ``group₁ & mask₂`` and ``group₂ & mask₁``, so each distinct pair ``(contype,
+conaffinity)`` gets a bit of its own as its group, and its mask holds the bits of the pairs it touches: the same
+pairs collide.
 """
 
 from __future__ import annotations
@@ -19,7 +24,7 @@ import warnings
 
 import numpy as np
 
-from ..joints import BallJoint, HingeJoint, SliderJoint
+from ..joints import BallJoint, HingeJoint, PlanarJoint, SliderJoint, UniversalJoint
 from ..mass import require_invertible
 from ..math3d import quat_mul, quat_rotate
 from ..shapes import Box, Capsule, ConvexHull, Cylinder, Plane, Sphere
@@ -101,16 +106,52 @@ def _filters(model: ModelDescription) -> dict[tuple[int, int], tuple[int, int]]:
     return {p: (bits[p], sum(bits[q] for q in pairs if (p[0] & q[1]) or (q[0] & p[1]))) for p in pairs}
 
 
+def _composite(model, body) -> str | None:
+    """What several joints of ``body`` make in a World (``"universal"``, ``"ball"``, ``"planar"``; None for one
+    joint), or a ValueError naming the body and its joints."""
+    joints = body.joints
+    if len(joints) < 2:
+        return None
+    types = sorted(j.type for j in joints)
+    hinges = [j.axis for j in joints if j.type == "hinge"]
+    slides = [j.axis for j in joints if j.type == "slide"]
+    concurrent = all(np.allclose(j.pos, joints[0].pos, rtol=0.0, atol=1e-9) for j in joints)
+    if types == ["hinge", "hinge"] and concurrent and abs(float(hinges[0] @ hinges[1])) <= 1e-6:
+        return "universal"
+    if types == ["hinge"] * 3 and concurrent and abs(float(np.linalg.det(np.array(hinges)))) > 1e-6:
+        return "ball"
+    if (types == ["hinge", "slide", "slide"] and np.linalg.norm(np.cross(*slides)) > 1e-6
+            and max(abs(float(hinges[0] @ axis)) for axis in slides) <= 1e-6):  # fmt: skip
+        return "planar"
+    listed = ", ".join(f"{j.type} {j.name!r}" for j in joints)
+    raise ValueError(
+        f"{model.source}, line {body.line}: body {body.name!r} has joints {listed}; a tumble World joins two bodies "
+        "with one joint, which several make only as two hinges through one point with perpendicular axes, three "
+        "through one point with independent axes, or two slides and a hinge normal to both "
+        "(tumble.articulation.from_mjcf loads every model)"
+    )
+
+
 def _joint(model, body, world_body, parent, anchor, rotation_quat):
-    """The world joint of ``body`` (one hinge, slide or ball) to ``parent`` (a world body, or None)."""
+    """The world joint of ``body`` (its hinge, slide or ball, or what its joints make together, :func:`_composite`)
+    to ``parent`` (a world body, or None)."""
     joint = body.joints[0]
     axis = _rotate(rotation_quat, joint.axis)
+    composite = _composite(model, body)
+    a, b = (parent, world_body) if parent is not None else (world_body, None)
+    if composite == "ball":
+        return BallJoint(a, b, anchor)
+    if composite == "universal":  # the first hinge's axis turns with the parent, the second's with the body
+        first, second = axis, _rotate(rotation_quat, body.joints[1].axis)
+        return UniversalJoint(a, b, anchor, *((first, second) if b is not None else (second, first)))
+    if composite == "planar":
+        normal = next(j.axis for j in body.joints if j.type == "hinge")
+        return PlanarJoint(a, b, _rotate(rotation_quat, normal), anchor=anchor)
     bounds = {}
     if joint.range is not None and joint.type in ("hinge", "slide"):
         # zero at the model's pose, where MuJoCo's coordinate is ``ref``; tumble measures the child's turn (or
         # travel) relative to its parent or, joined to the world, relative to the world: MuJoCo's sense both ways
         bounds = {"lower": joint.range[0] - joint.ref, "upper": joint.range[1] - joint.ref}
-    a, b = (parent, world_body) if parent is not None else (world_body, None)
     if joint.type == "hinge":
         return HingeJoint(a, b, anchor, axis, **bounds)
     if joint.type == "slide":
@@ -118,18 +159,29 @@ def _joint(model, body, world_body, parent, anchor, rotation_quat):
     return BallJoint(a, b, anchor)
 
 
-def _check(model: ModelDescription) -> None:
+def _check(model: ModelDescription) -> set[str]:
+    """Refuse what a World cannot hold, warn of what it leaves out; returns the names of the joints merged into
+    one world joint (:func:`_composite`), whose actuators are left out."""
+    merged, limited = set(), []
     for body in model.bodies:
-        if len(body.joints) > 1:
-            raise ValueError(
-                f"{model.source}, line {body.line}: body {body.name!r} has {len(body.joints)} joints; a "
-                "tumble World joins two bodies with one joint (tumble.articulation.from_mjcf loads it)"
-            )
+        if _composite(model, body) is not None:
+            merged |= {j.name for j in body.joints}
+            limited += [j.name for j in body.joints if j.range is not None]
+    if limited:
+        warnings.warn(f"{model.source}: the ranges of joints {', '.join(map(repr, limited))} are not enforced: each "
+                      "is one of several joints of a body, which a World joins as one joint (universal, ball or "
+                      "planar) without limits (yet)", MJCFWarning, stacklevel=3)  # fmt: skip
+    driving = [a.name or a.joint for a in model.actuators if a.joint in merged]
+    if driving:
+        warnings.warn(f"{model.source}: actuators {', '.join(map(repr, driving))} are left out: their joints are "
+                      "each one of several joints of a body, which a World joins as one joint without actuators "
+                      "(yet)", MJCFWarning, stacklevel=3)  # fmt: skip
     notes = sorted({name for b in model.bodies for j in b.joints for name in ("damping", "armature", "stiffness",
                     "frictionloss") if getattr(j, name)})  # fmt: skip
     if notes:
         warnings.warn(f"{model.source}: joint {', '.join(notes)} are not simulated by a tumble World's joints (yet); "
                       "ignored", MJCFWarning, stacklevel=3)  # fmt: skip
+    return merged
 
 
 def _moving_body(model: ModelDescription, index: int, welded: list[int], poses, filters):
@@ -165,7 +217,7 @@ def to_world(model: ModelDescription, world=None, position=(0.0, 0.0, 0.0), orie
     model placed at ``position``/``orientation``; returns the world."""
     from ..world import World
 
-    _check(model)
+    merged = _check(model)
     world = World(gravity=model.gravity) if world is None else world
     place = (np.asarray(position, float), np.asarray(orientation, float))
     filters = _filters(model)
@@ -216,7 +268,7 @@ def to_world(model: ModelDescription, world=None, position=(0.0, 0.0, 0.0), orie
         anchor = frame[0] + _rotate(frame[1], body.joints[0].pos)
         joints[body.joints[0].name] = (world.add_joint(_joint(model, body, handle, handles.get(parent), anchor,
                                                               frame[1])), body.joints[0])  # fmt: skip
-    for actuator in model.actuators:  # on hinges and slides, which every loaded body has at most one of
+    for actuator in (a for a in model.actuators if a.joint not in merged):  # on a body's only hinge or slide
         joint, description = joints[actuator.joint]
         world.add_joint_actuator(joint, gear=actuator.gear, gain=actuator.gain, bias=actuator.bias,
                                  ctrl_range=actuator.ctrl_range, ref=description.ref, name=actuator.name)  # fmt: skip

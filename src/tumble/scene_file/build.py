@@ -117,6 +117,10 @@ def _joint(spec, bodies: dict, place: str, label: str):
         return joint_types.SliderJoint(a, b, **options)
     if isinstance(spec, schema.FixedJoint):
         return joint_types.FixedJoint(a, b, **options)
+    if isinstance(spec, schema.PlanarJoint):
+        return joint_types.PlanarJoint(a, b, **options)
+    if isinstance(spec, schema.UniversalJoint):
+        return joint_types.UniversalJoint(a, b, **options)
     if spec.type == "rope" and "min_length" not in options:
         options["min_length"] = 0.0
     return joint_types.DistanceJoint(a, b, **options)

@@ -125,6 +125,19 @@ def joint_entry(joint, names: list[str]) -> dict:
         entry["max_motor_torque" if joint.kind == "hinge" else "max_motor_force"] = max_motor
     elif joint.kind == "fixed":
         entry["anchor"] = anchor
+    elif joint.kind == "planar":
+        entry.update(anchor=anchor, normal=axis)
+    elif joint.kind == "universal":
+        # the solver's a carries the frame's x axis, its b the y axis (joined to the world: the world carries x)
+        frame_b = spec.local_frame_b
+        if spec.body_b >= 0:
+            frame_b = quat_multiply(joint._world.state.body_quat[spec.body_b], frame_b)
+        carried_b = _floats(quat_rotate(frame_b, (0.0, 1.0, 0.0)))
+        # perpendicular as the joint holds them to its tolerance; written so to round-off, as UniversalJoint asks
+        carried_b = np.asarray(carried_b) - (np.asarray(carried_b) @ np.asarray(axis)) * np.asarray(axis)
+        carried_b = _floats(carried_b / np.linalg.norm(carried_b))
+        axes = (axis, carried_b) if not spec.to_world else (carried_b, axis)
+        entry.update(anchor=anchor, axis_a=axes[0], axis_b=axes[1])
     else:
         entry.update(anchor_a=anchor, anchor_b=_floats(joint.anchor_b), length=target, min_length=lower,
                      max_length=upper, spring_hertz=hertz, spring_damping_ratio=ratio)  # fmt: skip

@@ -239,7 +239,23 @@ class DistanceJoint(_Joint):
     spring_damping_ratio: NonNegative = 0.0
 
 
-Joint = Annotated[BallJoint | HingeJoint | SliderJoint | FixedJoint | DistanceJoint, Field(discriminator="type")]
+class PlanarJoint(_Joint):
+    type: Literal["planar"]
+    normal: Vector3
+    anchor: Vector3 | None = None
+
+
+class UniversalJoint(_Joint):
+    type: Literal["universal"]
+    anchor: Vector3
+    axis_a: Vector3
+    axis_b: Vector3
+
+
+Joint = Annotated[
+    BallJoint | HingeJoint | SliderJoint | FixedJoint | DistanceJoint | PlanarJoint | UniversalJoint,
+    Field(discriminator="type"),
+]
 
 
 # --- articulations -------------------------------------------------------------------------------------

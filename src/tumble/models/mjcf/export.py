@@ -142,7 +142,29 @@ def _velocity(world, i: int, point) -> tuple[np.ndarray, np.ndarray]:
     return np.asarray(body.point_velocity(point), float), np.asarray(body.angular_velocity, float)
 
 
-def _joint_xml(world, child: int, parent: int, entry, qpos: list, qvel: list, driven=None) -> str:
+def _composite_xml(entry, local: str, rotation_t, child_is_a: bool, w_rel, v_rel, qpos: list, qvel: list) -> str:
+    """A planar joint as two slides and a hinge, a universal joint as two hinges (the parent's axis first, as
+    MuJoCo composes a body's joints), each zero at the present pose."""
+    if entry["type"] == "planar":
+        normal = np.asarray(entry["normal"], float)
+        helper = np.array([0.0, 0.0, 1.0]) if abs(normal[2]) < 0.9 else np.array([1.0, 0.0, 0.0])
+        u = np.cross(helper, normal)
+        u /= np.linalg.norm(u)
+        axes = [("slide", u), ("slide", np.cross(normal, u)), ("hinge", normal)]
+    else:
+        first, second = np.asarray(entry["axis_a"], float), np.asarray(entry["axis_b"], float)
+        second = second - (second @ first) * first  # perpendicular as the joint holds them, to round-off
+        second /= np.linalg.norm(second)
+        axes = [("hinge", second), ("hinge", first)] if child_is_a else [("hinge", first), ("hinge", second)]
+    out = []
+    for kind, axis in axes:
+        qpos.append(0.0)
+        qvel.append(float(axis @ (w_rel if kind == "hinge" else v_rel)))
+        out.append(f"<joint type='{kind}' {local} axis='{_num(rotation_t @ axis)}'/>")
+    return "".join(out)
+
+
+def _joint_xml(world, child: int, parent: int, entry, qpos: list, qvel: list, driven=None, child_is_a=True) -> str:
     """The child's joint element (and its keyframe coordinates): the present pose is the joint's zero, or, for a
     joint that actuators drive (``driven``: its name, MuJoCo's sense against the world joint's, and its ``ref``),
     that ``ref``, so that the actuators' lengths are the same in both engines."""
@@ -153,13 +175,16 @@ def _joint_xml(world, child: int, parent: int, entry, qpos: list, qvel: list, dr
         qpos += [*position, *quat]
         qvel += [*v, *(rotation_t @ w)]
         return "<freejoint/>"
-    kind = {"ball": "ball", "hinge": "hinge", "slider": "slide", "fixed": None}[entry["type"]]
+    kind = {"ball": "ball", "hinge": "hinge", "slider": "slide", "fixed": None}.get(entry["type"], entry["type"])
     if kind is None:
         return ""
     anchor = np.asarray(entry["anchor"], float)
     v_child, w_child = _velocity(world, child, anchor)
     v_parent, w_parent = _velocity(world, parent, anchor)
     local = f"pos='{_num(rotation_t @ (anchor - position))}'"
+    if kind in ("planar", "universal"):
+        return _composite_xml(entry, local, rotation_t, child_is_a, w_child - w_parent, v_child - v_parent, qpos,
+                              qvel)  # fmt: skip
     if kind == "ball":
         qpos += [1.0, 0.0, 0.0, 0.0]
         qvel += list(rotation_t @ (w_child - w_parent))
@@ -190,8 +215,8 @@ def _loop_xml(world, entry, index: dict[str, int]) -> str:
         return "".join(f"<connect {first} anchor='{_num(rotation_t @ (p - position))}'/>" for p in ends)
     if entry["type"] == "fixed":
         return f"<weld {first}/>"
-    raise ValueError(f"to_mjcf: the slider joint of {entry['a']!r} and {entry['b']!r} closes a loop, which MJCF's "
-                     "equality constraints cannot hold")  # fmt: skip
+    raise ValueError(f"to_mjcf: the {entry['type']} joint of {entry['a']!r} and {entry['b']!r} closes a loop, which "
+                     "MJCF's equality constraints cannot hold")  # fmt: skip
 
 
 def _driven_joints(world, via: dict, names: list[str]) -> dict[int, tuple[str, float, float]]:
@@ -257,7 +282,7 @@ def world_to_mjcf(world, *, timestep: float | None = None, model: str = "tumble"
         full = [inertia[0, 0], inertia[1, 1], inertia[2, 2], inertia[0, 1], inertia[0, 2], inertia[1, 2]]
         entry = via[i]
         drive = None if entry is None else driven.get(entry["_index"])
-        joint = _joint_xml(world, i, parent[i], entry, qpos, qvel, drive)
+        joint = _joint_xml(world, i, parent[i], entry, qpos, qvel, drive, entry is not None and entry["a"] == names[i])
         return (f"<body name={quoteattr(names[i])} pos='{_num(local_position)}' quat='{_num(local_quat)}'>{joint}"
                 f"<inertial pos='{_num(mp.com)}' mass='{_num([mp.mass])}' fullinertia='{_num(full)}'/>"
                 f"{_geoms(world, world.bodies[i], names[i], assets)}")  # fmt: skip
