@@ -98,11 +98,11 @@ def bench_model_files(chain_links: int = 100, repeat: int = 5) -> list[dict]:
 
 
 def bench_mjcf_contacts(seconds: float = 5.0, repeat: int = 3) -> list[dict]:
-    """Gymnasium's ant with contacts, in a tumble World (``tumble.load_mjcf``) and in MuJoCo, at the model's timestep
-    (0.01 s): dropped from its pose, its eight motors held at the same controls. Rows per engine: ``steps_per_s``
-    (best of ``repeat`` runs of ``seconds`` simulated), ``realtime`` (simulated over wall-clock seconds) and
-    ``x_mujoco`` (MuJoCo's time over tumble's: above 1 tumble is faster). The humanoid, also asked for by issue 26,
-    has bodies with several joints, which a tumble World does not load yet."""
+    """Gymnasium's ant and humanoid with contacts, in a tumble World (``tumble.load_mjcf``) and in MuJoCo, each at its
+    model's timestep (0.01 s and 0.003 s): dropped from its pose, the ant's eight motors held at the same controls,
+    the humanoid with none (a World leaves out the motors of its multi-hinge joints). Rows per model and engine:
+    ``steps_per_s`` (best of ``repeat`` runs of ``seconds`` simulated), ``realtime`` (simulated over wall-clock
+    seconds) and ``x_mujoco`` (MuJoCo's time over tumble's: above 1 tumble is faster)."""
     import numpy as np
 
     import tumble
@@ -110,38 +110,61 @@ def bench_mjcf_contacts(seconds: float = 5.0, repeat: int = 3) -> list[dict]:
     path = humanoid_path()
     if path is None:
         return []
-    path = os.path.join(os.path.dirname(path), "ant.xml")
-    ctrl = np.sin(np.arange(8) * 1.7)  # the same fixed controls in both, within the motors' range
+    folder = os.path.dirname(path)
+    rows = []
+    for name, ctrl in (("ant", np.sin(np.arange(8) * 1.7)), ("humanoid", None)):
+        model_path = os.path.join(folder, f"{name}.xml")
+        runs = {"tumble World": _tumble_world_run(tumble, model_path, ctrl, seconds)}
+        try:
+            import mujoco
 
-    def tumble_run() -> float:
+            runs["MuJoCo"] = _mujoco_run(mujoco, model_path, ctrl, seconds)
+        except ImportError:
+            pass
+        times = {engine: min(run() for _ in range(repeat)) for engine, run in runs.items()}
+        dt = _timestep(model_path)
+        steps = round(seconds / dt)
+        rows += [{"model": name, "dt": dt, "engine": engine, "steps_per_s": steps / wall, "realtime": seconds / wall,
+                  **({"x_mujoco": times["MuJoCo"] / wall} if "MuJoCo" in times else {})}
+                 for engine, wall in times.items()]  # fmt: skip
+    return rows
+
+
+def _timestep(path: str) -> float:
+    from tumble.models.mjcf import read_mjcf
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return float(read_mjcf(path).timestep)
+
+
+def _tumble_world_run(tumble, path: str, ctrl, seconds: float):
+    dt = _timestep(path)
+
+    def run() -> float:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             world = tumble.load_mjcf(path)
-        world.ctrl = ctrl
-        world.step(0.01)  # the kernels loaded before timing
+        if ctrl is not None:
+            world.ctrl = ctrl
+        world.step(dt)  # the kernels loaded before timing
         start = time.perf_counter()
-        for _ in range(round(seconds / 0.01)):
-            world.step(0.01)
+        for _ in range(round(seconds / dt)):
+            world.step(dt)
         return time.perf_counter() - start
 
-    runs = {"tumble World": tumble_run}
-    try:
-        import mujoco
+    return run
 
-        def mujoco_run() -> float:
-            model = mujoco.MjModel.from_xml_path(path)
-            data = mujoco.MjData(model)
+
+def _mujoco_run(mujoco, path: str, ctrl, seconds: float):
+    def run() -> float:
+        model = mujoco.MjModel.from_xml_path(path)
+        data = mujoco.MjData(model)
+        if ctrl is not None:
             data.ctrl[:] = ctrl
-            mujoco.mj_step(model, data)
-            start = time.perf_counter()
-            mujoco.mj_step(model, data, nstep=round(seconds / model.opt.timestep))
-            return time.perf_counter() - start
+        mujoco.mj_step(model, data)
+        start = time.perf_counter()
+        mujoco.mj_step(model, data, nstep=round(seconds / model.opt.timestep))
+        return time.perf_counter() - start
 
-        runs["MuJoCo"] = mujoco_run
-    except ImportError:
-        pass
-    times = {engine: min(run() for _ in range(repeat)) for engine, run in runs.items()}
-    steps = round(seconds / 0.01)
-    return [{"model": "ant", "engine": engine, "steps_per_s": steps / wall, "realtime": seconds / wall,
-             **({"x_mujoco": times["MuJoCo"] / wall} if "MuJoCo" in times else {})}
-            for engine, wall in times.items()]  # fmt: skip
+    return run

@@ -270,6 +270,7 @@ def test_mjcf_contacts_rows_for_both_engines():
     rows = model_files.bench_mjcf_contacts(seconds=0.05, repeat=1)
     _assert_finite_numbers(rows)
     assert {r["engine"] for r in rows} >= {"tumble World"}
+    assert {r["model"] for r in rows} == {"ant", "humanoid"}
 
 
 def test_broad_phase_rows_for_both_worlds_and_pairs_in_the_pile():
