@@ -1,5 +1,5 @@
-"""Actuators on a world's hinges and sliders, driven by ``world.ctrl``: MJCF's ``motor``, ``position``, ``velocity``
-and ``general`` actuators once ``tumble.load_mjcf`` has put the model into a world.
+"""Actuators on a world's hinges, sliders, universal and ball joints, driven by ``world.ctrl``: MJCF's ``motor``,
+``position``, ``velocity`` and ``general`` actuators once ``tumble.load_mjcf`` has put the model into a world.
 
 Each pulls along its length ``l = gear · q`` with ``f = gain · c + bias₀ + bias₁ l + bias₂ l̇`` (``c`` the control
 clipped to its range, ``q`` MuJoCo's joint coordinate: ``ref`` plus the world joint's angle or translation) and
@@ -7,6 +7,14 @@ pushes its joint with ``gear · f``: a torque about the hinge's axis (a force al
 the opposite on the other. The forces are worked out from the joints' coordinates before each step by a world
 controller, and held through the step (explicitly: a stiff servo wants small steps, as it does in MuJoCo's Euler).
 The bodies an actuator drives do not fall asleep.
+
+A universal or ball joint has several coordinates, as the hinges MuJoCo composes in one body have: the relative
+rotation of the joint's second body (in the solver: ``b`` relative to ``a``) is ``R(u₁, q₁) R(u₂, q₂)`` about its two
+axes (the first carried by ``a``, the second by ``b``), or ``R(u₁, q₁) R(u₂, q₂) R(u₃, q₃)`` about three orthonormal
+axes given for a ball joint (Euler angles: in the axes' own basis ``B``, ``Bᵀ R B = R_x(σq₁) R_y(σq₂) R_z(σq₃)``,
+``σ = det B``, read off the matrix). Their rates solve ``ω_b − ω_a = Σ q̇ᵢ uᵢ`` with the axes ``uᵢ`` where they are
+now (``u₂`` turned by ``q₁``), and generalised forces ``τ`` are the moment ``M`` with ``uᵢ·M = τᵢ`` on ``b``, ``−M``
+on ``a`` (the virtual work of the coordinates).
 """
 
 from __future__ import annotations
@@ -30,6 +38,8 @@ class JointDrive:
     bias: np.ndarray  # (3,)
     ctrl_range: tuple[float, float] | None
     ref: float  # the joint's MuJoCo coordinate when the world joint reads zero
+    coordinate: int = 0  # which of a universal (0: about axis_a) or ball joint's angles
+    axes: np.ndarray | None = None  # (3, 3) a ball joint's hinge axes as rows, in the joint's frame on a
 
 
 class JointDrives:
@@ -39,11 +49,13 @@ class JointDrives:
         self.drives: list[JointDrive] = []
         self.ctrl = np.zeros(0)
 
-    def add(self, world, joint, *, gear, gain, bias, ctrl_range, ref, name=None) -> JointDrive:
-        if joint.kind not in ("hinge", "slider"):
-            raise ValueError(f"a joint actuator drives a hinge or a slider, got a {joint.kind} joint")
+    def add(self, world, joint, *, gear, gain, bias, ctrl_range, ref, name=None, coordinate=0,
+            axes=None) -> JointDrive:  # fmt: skip
+        if joint.kind not in ("hinge", "slider", "universal", "ball"):
+            raise ValueError(f"a joint actuator drives a hinge, slider, universal or ball joint, got a {joint.kind} "
+                             "joint")  # fmt: skip
         drive = JointDrive(len(self.drives), name, joint, float(gear), float(gain), np.asarray(bias, float),
-                           ctrl_range, float(ref))  # fmt: skip
+                           ctrl_range, float(ref), coordinate, axes)  # fmt: skip
         if not self.drives:
             world.add_controller(self.apply, name="joint actuators")
         self.drives.append(drive)
@@ -52,24 +64,37 @@ class JointDrives:
 
     def forces(self, world) -> np.ndarray:
         """Each actuator's force ``f`` along its length now (before its gear)."""
+        return self._forces(world, _spins(world))[0]
+
+    def _forces(self, world, angular_velocities) -> tuple[np.ndarray, dict]:
+        """Each actuator's force, and the coordinates' frames of the universal and ball joints they drive."""
         from .dynamics.joint_solver import joint_coordinates
 
         state = world.state
         coordinates = np.zeros((len(world.joints), 5))  # every joint's (coordinate, rate, ...) in one call
         joint_coordinates(world.model.joints, state.body_pos, state.body_quat, state.body_linvel,
-                          world.angular_velocities(), 0, len(coordinates), coordinates)  # fmt: skip
+                          angular_velocities, 0, len(coordinates), coordinates)  # fmt: skip
+        multi = {}  # each universal or ball joint's angles, rates and axes, once however many actuators drive it
+        for d in self.drives:
+            if d.joint.kind in ("universal", "ball") and d.joint.index not in multi:
+                multi[d.joint.index] = _angles(world, d, angular_velocities)
         out = np.zeros(len(self.drives))
         for k, d in enumerate(self.drives):
-            q, qd = coordinates[d.joint.index, :2]
+            if d.joint.index in multi:
+                q, qd, _ = multi[d.joint.index]
+                q, qd = q[_component(world, d)], qd[_component(world, d)]
+            else:
+                q, qd = coordinates[d.joint.index, :2]
             c = float(self.ctrl[d.index])
             if d.ctrl_range is not None:
                 c = min(max(c, d.ctrl_range[0]), d.ctrl_range[1])
             out[k] = d.gain * c + d.bias @ (1.0, d.gear * (d.ref + q), d.gear * qd)
-        return out
+        return out, multi
 
     def apply(self, world, t) -> None:
         """Before a step: each actuator's torque (or force) on its two bodies, added to the step's loads at once."""
-        loads = np.array([d.gear for d in self.drives]) * self.forces(world)
+        forces, multi = self._forces(world, _spins(world))
+        loads = np.array([d.gear for d in self.drives]) * forces
         state, inputs = world.state, world.inputs
         specs = [world._builder.joints[d.joint.index] for d in self.drives]
         # the joint's axis: the x axis of its frame, kept in the first body's frame (the world's, if that is it)
@@ -78,7 +103,13 @@ class JointDrives:
         held = first >= 0
         frames[held] = _multiply(state.body_quat[first[held]], frames[held])
         loads = loads[:, None] * _x_axis(frames)
-        hinge = np.array([d.joint.kind == "hinge" for d in self.drives])
+        # a universal or ball joint's generalised force as the moment M with uᵢ·M = τᵢ (module docstring): for a
+        # universal joint the one in the plane of its two axes
+        for k, d in enumerate(self.drives):
+            if d.joint.index in multi:
+                inverse = multi[d.joint.index][2]  # uᵢ·M = τᵢ: M = (the axes' rows)⁺ τ
+                loads[k] = d.gear * forces[k] * inverse[:, _component(world, d)]
+        hinge = np.array([d.joint.kind != "slider" for d in self.drives])
         # the coordinate is the second body's motion relative to the first (or to the world)
         for bodies, sign in (([spec.body_b for spec in specs], 1.0), (first, -1.0)):
             for k, body in enumerate(bodies):
@@ -92,6 +123,65 @@ class JointDrives:
                     island = state.body_island == state.body_island[body]
                     state.body_sleeping[island] = False
                 state.body_sleep_time[body] = 0.0
+
+
+def _component(world, drive: JointDrive) -> int:
+    """The drive's coordinate in the solver's order: a universal joint to the world has the world as its solver's
+    ``a``, which carries the frame's x axis, the user's ``axis_b``."""
+    if drive.joint.kind == "universal" and world._builder.joints[drive.joint.index].to_world:
+        return 1 - drive.coordinate
+    return drive.coordinate
+
+
+def joint_frames(world, index: int) -> tuple[np.ndarray, np.ndarray]:
+    """The rotation matrices of joint ``index``'s frames now, carried by the solver's ``a`` and ``b``."""
+    spec, quats = world._builder.joints[index], world.state.body_quat
+    frame_a = spec.local_frame_a
+    if spec.body_a >= 0:
+        frame_a = _multiply(quats[spec.body_a][None], frame_a[None])[0]
+    frame_b = _multiply(quats[spec.body_b][None], spec.local_frame_b[None])[0]
+    return _matrix(frame_a), _matrix(frame_b)
+
+
+def _angles(world, drive: JointDrive, angular_velocities) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A universal or ball joint's angles, their rates, and the (pseudo-)inverse of its axes where they are now
+    (rows ``uᵢ``, world frame): the matrix ``P`` with ``q̇ = Pᵀ (ω_b − ω_a)`` and ``M = P τ``."""
+    index = drive.joint.index
+    spec = world._builder.joints[index]
+    frame_a, frame_b = joint_frames(world, index)
+    relative = frame_a.T @ frame_b  # b's joint frame in a's
+    if drive.axes is None:  # universal: R_x(q₁) R_y(q₂), x carried by a, y by b
+        q = np.array([np.arctan2(relative[2, 1], relative[1, 1]), np.arctan2(relative[0, 2], relative[0, 0])])
+        inverse = np.column_stack([frame_a[:, 0], frame_b[:, 1]])  # orthonormal rows: their transpose
+    else:
+        basis = drive.axes.T  # columns: the three axes in a's joint frame
+        sense = np.sign(np.linalg.det(basis))
+        r = basis.T @ relative @ basis  # R_x(σq₁) R_y(σq₂) R_z(σq₃)
+        q = sense * np.array([np.arctan2(-r[1, 2], r[2, 2]), np.arcsin(np.clip(r[0, 2], -1.0, 1.0)),
+                              np.arctan2(-r[0, 1], r[0, 0])])  # fmt: skip
+        (ux, uy, uz), v = basis[:, 0], basis[:, 1]  # v turned about u by q₁ (Rodrigues; u ⊥ v)
+        u_cross_v = np.array([uy * v[2] - uz * v[1], uz * v[0] - ux * v[2], ux * v[1] - uy * v[0]])
+        turned = np.cos(q[0]) * v + np.sin(q[0]) * u_cross_v
+        inverse = np.linalg.inv(np.array([frame_a @ basis[:, 0], frame_a @ turned, frame_b @ basis[:, 2]]))
+    spin_a = np.zeros(3) if spec.body_a < 0 else angular_velocities[spec.body_a]
+    return q, inverse.T @ (angular_velocities[spec.body_b] - spin_a), inverse
+
+
+def _spins(world) -> np.ndarray:
+    """``ω = R I⁻¹ Rᵀ L`` of every body (world frame), as ``World.angular_velocities`` gives it, without its
+    validation of each quaternion (a third of a millisecond a step here)."""
+    model, state = world.model, world.state
+    rotations = np.moveaxis(_matrix(state.body_quat.T), (0, 1), (1, 2))  # (n, 3, 3)
+    local = np.einsum("nji,nj->ni", rotations, state.body_angmom)
+    return np.einsum("nij,nj->ni", rotations, np.einsum("nij,nj->ni", model.body_inv_inertia_local, local))
+
+
+def _matrix(q: np.ndarray) -> np.ndarray:
+    """The rotation matrix of the unit quaternion ``q`` (w, x, y, z); of each, (3, 3, n), for (4, n)."""
+    w, x, y, z = q
+    return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+                     [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+                     [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])  # fmt: skip
 
 
 def _multiply(a: np.ndarray, b: np.ndarray) -> np.ndarray:

@@ -382,16 +382,23 @@ class World:
         return list(self._actuation.actuators)
 
     def add_joint_actuator(self, joint: Joint, *, gear=1.0, gain=1.0, bias=(0.0, 0.0, 0.0), ctrl_range=None,
-                           ref=0.0, name: str | None = None):  # fmt: skip
-        """Drive a hinge or slider from ``world.ctrl`` (its new last entry, starting at 0); returns its record.
+                           ref=0.0, name: str | None = None, coordinate: int = 0, axes=None):  # fmt: skip
+        """Drive a hinge, slider, universal or ball joint from ``world.ctrl`` (its new last entry, starting at 0);
+        returns its record.
 
         The actuator pulls along its length ``l = gear · (ref + q)`` (``q`` the joint's angle or translation, zero
         at its creation; ``ref`` the coordinate that is, MJCF's ``ref``) with ``f = gain · c + bias[0] + bias[1] l
         + bias[2] l̇`` (``c`` the control clipped to ``ctrl_range``) and turns (pushes) the joint's second body with
         ``gear · f``, the first with the opposite: a motor is the default, a position servo ``gain=kp, bias=(0,
         -kp, -kv)``, a velocity servo ``gain=kv, bias=(0, 0, -kv)`` (``tumble/joint_drives.py``). The loads are
-        worked out before each step and held through it."""
-        from .joint_drives import JointDrives
+        worked out before each step and held through it.
+
+        A universal joint's ``coordinate`` 0 or 1 is its turn about ``axis_a`` or ``axis_b``; ``b``'s rotation
+        relative to ``a`` (``a``'s relative to the world when ``b`` is None) is the turn about the reference side's
+        axis, then the other's. A ball joint's are three angles about ``axes`` ((3, 3), orthonormal rows, world
+        frame now), turned in order as MuJoCo turns a body's three hinges: the first axis carried by the reference
+        side (``a``, or the world when ``b`` is None), the last by the other; all zero at the joint's creation."""
+        from .joint_drives import JointDrives, joint_frames
 
         if not isinstance(joint, Joint) or joint._world is not self:
             raise TypeError(f"joint must be a joint of this world, got {joint!r}")
@@ -402,10 +409,22 @@ class World:
             if not low <= high:
                 raise ValueError(f"ctrl_range must be (low, high) with low <= high, got {ctrl_range!r}")
             ctrl_range = (low, high)
+        count = {"universal": 2, "ball": 3}.get(joint.kind, 1)
+        if isinstance(coordinate, bool) or not isinstance(coordinate, (int, np.integer)) or not 0 <= coordinate < count:
+            raise ValueError(f"coordinate must be an integer in 0 to {count - 1} for a {joint.kind} joint, got "
+                             f"{coordinate!r}")  # fmt: skip
+        if (axes is None) != (joint.kind != "ball"):
+            raise ValueError(f"axes must be given for a ball joint's actuator and only for it, got {axes!r} for a "
+                             f"{joint.kind} joint")  # fmt: skip
+        if axes is not None:
+            axes = as_array("axes", axes, (3, 3), batch=False)
+            if not np.allclose(axes @ axes.T, np.eye(3), rtol=0.0, atol=1e-6):
+                raise ValueError(f"axes must be three orthonormal rows, got {axes.tolist()}")
+            axes = axes @ joint_frames(self, joint.index)[0]  # in the joint's frame on its (solver's) first body
         if self._joint_drives is None:
             self._joint_drives = JointDrives()
         return self._joint_drives.add(self, joint, gear=gear, gain=gain, bias=bias, ctrl_range=ctrl_range, ref=ref,
-                                      name=name)  # fmt: skip
+                                      name=name, coordinate=int(coordinate), axes=axes)  # fmt: skip
 
     @property
     def ctrl(self) -> np.ndarray:

@@ -116,3 +116,43 @@ def test_bad_planar_and_universal_joints_are_refused():
     with pytest.raises(ValueError, match="anchor"):
         tumble.UniversalJoint(body, None, (0, float("nan"), 0), (1, 0, 0), (0, 1, 0))
     assert world.joints == []
+
+
+@pytest.mark.parametrize("to_world", [True, False])
+def test_servos_on_a_universal_joints_two_angles_turn_the_body_to_their_targets(to_world):
+    """No gravity, a box pinned at its centre to the world (or to a heavy body welded still): position servos hold
+    its angle about the axis it carries at 0.5 and the one about the fixed side's axis at -0.3. The coordinates are
+    those of ``b`` relative to ``a`` (of ``a`` relative to the world when ``b`` is None), the turn about the fixed
+    side's axis first: the box ends turned ``R(fixed axis, -0.3) R(box's axis, 0.5)`` from where it started."""
+    world = tumble.World(gravity=(0.0, 0.0, 0.0))
+    start = quat_from_axis_angle((0.2, 0.9, -0.4), 0.7)
+    box = world.add_body(tumble.Box((0.4, 0.2, 0.1)), mass=1.0, orientation=start)
+    carried, fixed = np.array([1.0, 0.0, 0.0]), np.array([0.0, 0.6, 0.8])
+    if to_world:  # axis_a is carried by a, the box
+        joint = world.add_joint(tumble.UniversalJoint(box, None, (0.0, 0.0, 0.0), carried, fixed))
+        targets = [0.5, -0.3]
+    else:  # axis_a is carried by a, the still body
+        base = world.add_static(tumble.Sphere(0.1), position=(0.0, 0.0, -1.0))
+        holder = world.add_body(tumble.Sphere(0.1), mass=1e3, position=(0.0, 0.0, -0.5))
+        world.add_joint(tumble.FixedJoint(holder, base))
+        joint = world.add_joint(tumble.UniversalJoint(holder, box, (0.0, 0.0, 0.0), fixed, carried))
+        targets = [-0.3, 0.5]
+    for coordinate in (0, 1):
+        world.add_joint_actuator(joint, gain=0.5, bias=(0.0, -0.5, -0.2), coordinate=coordinate)
+    world.ctrl = targets
+    world.simulate(8.0, 1 / 240)
+    turned = quat_multiply(quat_from_axis_angle(fixed, -0.3), quat_from_axis_angle(carried, 0.5))
+    assert abs(abs(float(quat_multiply(turned, start) @ box.orientation)) - 1.0) < 1e-8
+    np.testing.assert_allclose(world.actuator_forces(), 0.0, atol=1e-5)
+
+
+def test_a_motor_on_a_universal_joints_angle_turns_the_body_about_that_axis():
+    world = tumble.World(gravity=(0.0, 0.0, 0.0))
+    box = world.add_body(tumble.Box((0.4, 0.2, 0.1)), mass=1.0)
+    joint = world.add_joint(tumble.UniversalJoint(box, None, (0.0, 0.0, 0.0), (1.0, 0.0, 0.0), (0.0, 1.0, 0.0)))
+    world.add_joint_actuator(joint, gear=2.0, coordinate=1, name="pitch")
+    world.ctrl = [1.5]
+    world.step(0.01)
+    inertia_y = 1.0 * (0.4**2 + 0.1**2) / 12.0
+    np.testing.assert_allclose(box.angular_velocity, [0.0, 2.0 * 1.5 / inertia_y * 0.01, 0.0], atol=1e-9)
+    np.testing.assert_allclose(world.actuator_forces(), [1.5])

@@ -227,3 +227,10 @@ def test_planar_and_universal_joints_go_through_a_scene_file(tmp_path):
         w.simulate(0.5, 1 / 1000)
     for body, other in zip(world.bodies, copy.bodies, strict=True):
         np.testing.assert_allclose(other.position, body.position, rtol=0, atol=1e-5)  # warm starts are not saved
+
+
+def test_an_actuator_on_a_universal_joints_angle_is_refused_by_to_mjcf():
+    world = _walker()
+    world.add_joint_actuator(world.joints[1], coordinate=1)
+    with pytest.raises(ValueError, match="to_mjcf: actuator 0 drives a universal joint's angle, which is not written"):
+        world.to_mjcf()

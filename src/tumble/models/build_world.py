@@ -9,7 +9,8 @@ leaves the body free. Several joints of one body become the one world joint that
 hinges through one point with perpendicular axes a :class:`~tumble.UniversalJoint` (the first axis carried by the
 parent, the second by the body, as MuJoCo composes them), three hinges through one point with independent axes a
 :class:`~tumble.BallJoint`, two slides and a hinge normal to both a :class:`~tumble.PlanarJoint` (the root of
-the 2-D walkers); their ranges and actuators are left out with a warning. Any other set is refused
+the 2-D walkers); their actuators drive the joint's angles (a planar joint's are left out with a warning), their
+ranges are left out with a warning. Any other set is refused
 (``tumble.articulation.from_mjcf`` loads every model). Geoms become shapes (a mesh its convex hull, as MuJoCo
 collides it; an ellipsoid the hull of 162 points on it); geoms that collide with nothing (``contype = conaffinity =
 0``) are left out. MuJoCo lets two geoms touch when ``contype₁ & conaffinity₂`` or ``contype₂ & conaffinity₁``;
@@ -160,28 +161,31 @@ def _joint(model, body, world_body, parent, anchor, rotation_quat):
 
 
 def _check(model: ModelDescription) -> set[str]:
-    """Refuse what a World cannot hold, warn of what it leaves out; returns the names of the joints merged into
-    one world joint (:func:`_composite`), whose actuators are left out."""
-    merged, limited = set(), []
+    """Refuse what a World cannot hold, warn of what it leaves out; returns the names of the joints whose actuators
+    are left out: those of a planar joint, and of a ball joint whose hinges are not orthonormal."""
+    undriven, limited = set(), []
     for body in model.bodies:
-        if _composite(model, body) is not None:
-            merged |= {j.name for j in body.joints}
+        composite = _composite(model, body)
+        if composite is not None:
             limited += [j.name for j in body.joints if j.range is not None]
+        axes = np.array([j.axis for j in body.joints])
+        if composite == "planar" or (composite == "ball" and not np.allclose(axes @ axes.T, np.eye(3), atol=1e-6)):
+            undriven |= {j.name for j in body.joints}
     if limited:
         warnings.warn(f"{model.source}: the ranges of joints {', '.join(map(repr, limited))} are not enforced: each "
                       "is one of several joints of a body, which a World joins as one joint (universal, ball or "
                       "planar) without limits (yet)", MJCFWarning, stacklevel=3)  # fmt: skip
-    driving = [a.name or a.joint for a in model.actuators if a.joint in merged]
+    driving = [a.name or a.joint for a in model.actuators if a.joint in undriven]
     if driving:
-        warnings.warn(f"{model.source}: actuators {', '.join(map(repr, driving))} are left out: their joints are "
-                      "each one of several joints of a body, which a World joins as one joint without actuators "
-                      "(yet)", MJCFWarning, stacklevel=3)  # fmt: skip
+        warnings.warn(f"{model.source}: actuators {', '.join(map(repr, driving))} are left out: their joints make a "
+                      "planar joint, or a ball joint of hinges that are not orthonormal, which a World's actuators "
+                      "do not drive (yet)", MJCFWarning, stacklevel=3)  # fmt: skip
     notes = sorted({name for b in model.bodies for j in b.joints for name in ("damping", "armature", "stiffness",
                     "frictionloss") if getattr(j, name)})  # fmt: skip
     if notes:
         warnings.warn(f"{model.source}: joint {', '.join(notes)} are not simulated by a tumble World's joints (yet); "
                       "ignored", MJCFWarning, stacklevel=3)  # fmt: skip
-    return merged
+    return undriven
 
 
 def _moving_body(model: ModelDescription, index: int, welded: list[int], poses, filters):
@@ -217,7 +221,7 @@ def to_world(model: ModelDescription, world=None, position=(0.0, 0.0, 0.0), orie
     model placed at ``position``/``orientation``; returns the world."""
     from ..world import World
 
-    merged = _check(model)
+    left_out = _check(model)
     world = World(gravity=model.gravity) if world is None else world
     place = (np.asarray(position, float), np.asarray(orientation, float))
     filters = _filters(model)
@@ -266,12 +270,19 @@ def to_world(model: ModelDescription, world=None, position=(0.0, 0.0, 0.0), orie
         parent = movers[body.parent] if body.parent >= 0 else -1
         frame = poses[index]
         anchor = frame[0] + _rotate(frame[1], body.joints[0].pos)
-        joints[body.joints[0].name] = (world.add_joint(_joint(model, body, handle, handles.get(parent), anchor,
-                                                              frame[1])), body.joints[0])  # fmt: skip
-    for actuator in (a for a in model.actuators if a.joint not in merged):  # on a body's only hinge or slide
-        joint, description = joints[actuator.joint]
+        joint = world.add_joint(_joint(model, body, handle, handles.get(parent), anchor, frame[1]))
+        composite = _composite(model, body)
+        for k, description in enumerate(body.joints):
+            # which of the world joint's coordinates this MJCF joint is: a universal joint to the world has the
+            # body's axis (the second hinge) as its axis_a; a ball joint's angles are about the hinges' axes
+            coordinate = (1 - k if parent < 0 else k) if composite == "universal" else k
+            axes = np.array([_rotate(frame[1], j.axis) for j in body.joints]) if composite == "ball" else None
+            joints[description.name] = (joint, description, coordinate, axes)
+    for actuator in (a for a in model.actuators if a.joint not in left_out):
+        joint, description, coordinate, axes = joints[actuator.joint]
         world.add_joint_actuator(joint, gear=actuator.gear, gain=actuator.gain, bias=actuator.bias,
-                                 ctrl_range=actuator.ctrl_range, ref=description.ref, name=actuator.name)  # fmt: skip
+                                 ctrl_range=actuator.ctrl_range, ref=description.ref, name=actuator.name,
+                                 coordinate=coordinate, axes=axes)  # fmt: skip
     return world
 
 

@@ -83,6 +83,11 @@ def _geoms(world, body, name: str, assets: list[str], pose=None) -> str:
 def _refuse_what_mjcf_cannot_say(world, joints: list[dict]) -> None:
     if world._vehicles or world.actuators:
         raise ValueError("to_mjcf: the world has vehicles or rotors and thrusters, which are not written to MJCF (yet)")
+    drives = [] if world._joint_drives is None else world._joint_drives.drives
+    for drive in drives:
+        if drive.joint.kind in ("universal", "ball"):
+            raise ValueError(f"to_mjcf: actuator {drive.index} drives a {drive.joint.kind} joint's angle, which is not "
+                             "written to MJCF (yet)")  # fmt: skip
     for entry in joints:
         label = f"the {entry['type']} joint of {entry['a']!r} and {entry['b']!r}"
         if entry["type"] == "distance":
