@@ -23,6 +23,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .math3d import quat_mul
+
 __all__ = ["JointDrive", "JointDrives"]
 
 
@@ -48,6 +50,8 @@ class JointDrives:
     def __init__(self) -> None:
         self.drives: list[JointDrive] = []
         self.ctrl = np.zeros(0)
+        self._kinds: list[str] = []  # each drive's joint kind and coordinate in the solver's order, read once
+        self._components: list[int] = []
 
     def add(self, world, joint, *, gear, gain, bias, ctrl_range, ref, name=None, coordinate=0,
             axes=None) -> JointDrive:  # fmt: skip
@@ -60,6 +64,10 @@ class JointDrives:
             world.add_controller(self.apply, name="joint actuators")
         self.drives.append(drive)
         self.ctrl = np.append(self.ctrl, 0.0)
+        self._kinds.append(joint.kind)
+        # a universal joint to the world has the world as the solver's a, which carries its frame's x axis: axis_b
+        flipped = joint.kind == "universal" and world._builder.joints[joint.index].to_world
+        self._components.append(1 - coordinate if flipped else coordinate)
         return drive
 
     def forces(self, world) -> np.ndarray:
@@ -75,14 +83,14 @@ class JointDrives:
         joint_coordinates(world.model.joints, state.body_pos, state.body_quat, state.body_linvel,
                           angular_velocities, 0, len(coordinates), coordinates)  # fmt: skip
         multi = {}  # each universal or ball joint's angles, rates and axes, once however many actuators drive it
-        for d in self.drives:
-            if d.joint.kind in ("universal", "ball") and d.joint.index not in multi:
+        for d, kind in zip(self.drives, self._kinds, strict=True):
+            if kind in ("universal", "ball") and d.joint.index not in multi:
                 multi[d.joint.index] = _angles(world, d, angular_velocities)
         out = np.zeros(len(self.drives))
         for k, d in enumerate(self.drives):
             if d.joint.index in multi:
                 q, qd, _ = multi[d.joint.index]
-                q, qd = q[_component(world, d)], qd[_component(world, d)]
+                q, qd = q[self._components[k]], qd[self._components[k]]
             else:
                 q, qd = coordinates[d.joint.index, :2]
             c = float(self.ctrl[d.index])
@@ -108,8 +116,8 @@ class JointDrives:
         for k, d in enumerate(self.drives):
             if d.joint.index in multi:
                 inverse = multi[d.joint.index][2]  # uᵢ·M = τᵢ: M = (the axes' rows)⁺ τ
-                loads[k] = d.gear * forces[k] * inverse[:, _component(world, d)]
-        hinge = np.array([d.joint.kind != "slider" for d in self.drives])
+                loads[k] = d.gear * forces[k] * inverse[:, self._components[k]]
+        hinge = [kind != "slider" for kind in self._kinds]
         # the coordinate is the second body's motion relative to the first (or to the world)
         for bodies, sign in (([spec.body_b for spec in specs], 1.0), (first, -1.0)):
             for k, body in enumerate(bodies):
@@ -125,22 +133,12 @@ class JointDrives:
                 state.body_sleep_time[body] = 0.0
 
 
-def _component(world, drive: JointDrive) -> int:
-    """The drive's coordinate in the solver's order: a universal joint to the world has the world as its solver's
-    ``a``, which carries the frame's x axis, the user's ``axis_b``."""
-    if drive.joint.kind == "universal" and world._builder.joints[drive.joint.index].to_world:
-        return 1 - drive.coordinate
-    return drive.coordinate
-
-
 def joint_frames(world, index: int) -> tuple[np.ndarray, np.ndarray]:
     """The rotation matrices of joint ``index``'s frames now, carried by the solver's ``a`` and ``b``."""
     spec, quats = world._builder.joints[index], world.state.body_quat
-    frame_a = spec.local_frame_a
-    if spec.body_a >= 0:
-        frame_a = _multiply(quats[spec.body_a][None], frame_a[None])[0]
-    frame_b = _multiply(quats[spec.body_b][None], spec.local_frame_b[None])[0]
-    return _matrix(frame_a), _matrix(frame_b)
+    frame_a = spec.local_frame_a if spec.body_a < 0 else quat_mul(tuple(quats[spec.body_a]), tuple(spec.local_frame_a))
+    frame_b = quat_mul(tuple(quats[spec.body_b]), tuple(spec.local_frame_b))
+    return _matrix(np.asarray(frame_a)), _matrix(np.asarray(frame_b))
 
 
 def _angles(world, drive: JointDrive, angular_velocities) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
