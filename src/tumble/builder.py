@@ -48,7 +48,7 @@ class JointSpec:
     local_anchor_b: np.ndarray  # (3,)
     local_frame_a: np.ndarray  # (4,) joint frame (x: axis) in a's frame
     local_frame_b: np.ndarray  # (4,)
-    drive: np.ndarray  # (8,) see joint_solver.JointArrays
+    drive: np.ndarray  # (9,) see joint_solver.JointArrays
     collide_connected: bool
     to_world: bool = False  # the user's ``b`` was None: the world is body_a (-1) and the user's ``a`` is body_b
 

@@ -382,8 +382,10 @@ def _require_joint(spec) -> None:
     for name in ("local_frame_a", "local_frame_b"):
         _require_quaternion(name, getattr(spec, name))
     drive = np.asarray(spec.drive)
-    if drive.shape != (8,):
-        raise ValueError(f"drive of shape {drive.shape}, expected (8,)")
+    if drive.shape == (8,):  # written before joints had damping (issue 26): none
+        spec.drive = drive = np.append(drive, 0.0)
+    if drive.shape != (9,):
+        raise ValueError(f"drive of shape {drive.shape}, expected (9,)")
     _require_numbers("drive", drive, allow_inf=True)
 
 

@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from ._validate import as_quaternion, as_rate, as_vector3, finite_result, listed
-from .dynamics.joint_solver import LOWER, MAX_MOTOR, MOTOR_SPEED, TARGET, UPPER, JointKind
+from .dynamics.joint_solver import DAMPING, LOWER, MAX_MOTOR, MOTOR_SPEED, TARGET, UPPER, JointKind
 from .rotation import quat_rotate, quat_to_matrix
 
 __all__ = ["Body", "Joint"]
@@ -500,6 +500,16 @@ class Joint:
     @spring_target.setter
     def spring_target(self, value) -> None:
         self._set_drive(TARGET, "spring_target", value, ("hinge", "slider"))
+
+    @property
+    def damping(self) -> float:
+        """Hinge [N m s/rad] or slider [N s/m]: the damping against its rate (settable)."""
+        self._require("hinge", "slider")
+        return float(self._spec().drive[DAMPING])
+
+    @damping.setter
+    def damping(self, value) -> None:
+        self._set_drive(DAMPING, "damping", value, ("hinge", "slider"), nonnegative=True)
 
     def __eq__(self, other) -> bool:
         return isinstance(other, Joint) and other._world is self._world and other._index == self._index

@@ -69,16 +69,17 @@ class _Drive:
     spring_damping_ratio: float
     spring_target: float
     cone: float = math.inf  # ball joints: the largest swing [rad]
+    damping: float = 0.0  # hinges and sliders: the torque (force) per unit rate, −damping · q̇ [N m s/rad, N s/m]
 
     @classmethod
     def checked(cls, lower, upper, motor_speed, max_motor_name, max_motor, spring_hertz, spring_damping_ratio,
-                spring_target) -> _Drive:  # fmt: skip
+                spring_target, damping) -> _Drive:  # fmt: skip
         lo, hi = _bounds("lower", lower, "upper", upper)
         return cls(
             lo, hi, as_float("motor_speed", motor_speed), as_float(max_motor_name, max_motor, nonnegative=True),
             as_float("spring_hertz", spring_hertz, nonnegative=True),
             as_float("spring_damping_ratio", spring_damping_ratio, nonnegative=True),
-            as_float("spring_target", spring_target),
+            as_float("spring_target", spring_target), damping=as_float("damping", damping, nonnegative=True),
         )  # fmt: skip
 
 
@@ -158,18 +159,20 @@ class HingeJoint(_JointBase):
         lower, upper: angle limits [rad] (``None``: free on that side).
         motor_speed: [rad/s] target of the motor; max_motor_torque: [N m] its bound (0: no motor).
         spring_hertz, spring_damping_ratio, spring_target: an angular spring towards ``spring_target`` [rad].
+        damping: [N m s/rad] a torque ``−damping · ω`` against the turning (MJCF's joint ``damping``; implicit, so
+            stable at any value).
     """
 
     kind = JointKind.HINGE
 
     def __init__(self, a, b, anchor, axis, *, lower=None, upper=None, motor_speed: float = 0.0,
                  max_motor_torque: float = 0.0, spring_hertz: float = 0.0, spring_damping_ratio: float = 0.0,
-                 spring_target: float = 0.0, collide_connected: bool = False):  # fmt: skip
+                 spring_target: float = 0.0, damping: float = 0.0, collide_connected: bool = False):  # fmt: skip
         self._set_bodies(a, b, collide_connected)
         self._set("anchor", as_vector3("anchor", anchor))
         self._set("axis", as_unit_vector3("axis", axis))
         self._set("drive", _Drive.checked(lower, upper, motor_speed, "max_motor_torque", max_motor_torque,
-                                          spring_hertz, spring_damping_ratio, spring_target))  # fmt: skip
+                                          spring_hertz, spring_damping_ratio, spring_target, damping))  # fmt: skip
 
 
 class SliderJoint(_JointBase):
@@ -182,19 +185,19 @@ class SliderJoint(_JointBase):
         axis: (3,) non-zero, world frame. anchor: (3,) a point on the axis [m] (default: ``b``'s origin, or
             ``a``'s when ``b`` is None).
         lower, upper: translation limits [m]; motor_speed [m/s], max_motor_force [N]; spring_* as for hinges
-            (target in metres).
+            (target in metres); damping [N s/m] a force ``−damping · v`` along the axis.
     """
 
     kind = JointKind.SLIDER
 
     def __init__(self, a, b, axis, *, anchor=None, lower=None, upper=None, motor_speed: float = 0.0,
                  max_motor_force: float = 0.0, spring_hertz: float = 0.0, spring_damping_ratio: float = 0.0,
-                 spring_target: float = 0.0, collide_connected: bool = False):  # fmt: skip
+                 spring_target: float = 0.0, damping: float = 0.0, collide_connected: bool = False):  # fmt: skip
         self._set_bodies(a, b, collide_connected)
         self._set("anchor", None if anchor is None else as_vector3("anchor", anchor))
         self._set("axis", as_unit_vector3("axis", axis))
         self._set("drive", _Drive.checked(lower, upper, motor_speed, "max_motor_force", max_motor_force,
-                                          spring_hertz, spring_damping_ratio, spring_target))  # fmt: skip
+                                          spring_hertz, spring_damping_ratio, spring_target, damping))  # fmt: skip
 
 
 class FixedJoint(_JointBase):
@@ -388,6 +391,7 @@ def joint_spec(joint, world) -> JointSpec:
                 d.spring_damping_ratio,
                 d.spring_target,
                 d.cone,
+                d.damping,
             ],
             np.float64,
         ),  # fmt: skip

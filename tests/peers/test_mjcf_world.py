@@ -54,8 +54,9 @@ def test_the_ant_loads_where_mujoco_puts_it_with_its_masses():
 
 
 def test_the_ant_dropped_comes_to_rest_on_the_floor_touching_only_it():
+    """With its joints' damping the ant stands on its ankles' stops and creeps at a few mm/s until about 9 s."""
     world = quiet_load(ANT)
-    for _ in range(240 * 3):
+    for _ in range(240 * 10):
         world.step(1 / 240)
     speeds = [np.linalg.norm(b.velocity) for b in world.bodies if not b.is_static]
     assert max(speeds) < 1e-3
@@ -107,7 +108,7 @@ def test_a_body_with_joints_a_world_joint_cannot_make_and_bad_arguments_are_refu
         tumble.load_mjcf(ANT, world="mine")
     with pytest.raises(ValueError, match="orientation"):
         tumble.load_mjcf(ANT, orientation=(0, 0, 0, 0))
-    with pytest.warns(UserWarning, match=r"ant\.xml: joint armature, damping are not simulated by a tumble World"):
+    with pytest.warns(UserWarning, match=r"ant\.xml: a tumble World's joints do not simulate joint armature \(yet"):
         ant = tumble.load_mjcf(ANT)
     assert ant.ctrl.shape == (8,)  # its eight motors
 
@@ -244,9 +245,10 @@ def _pitch(body) -> float:
                                 pytest.param(0.001, marks=pytest.mark.slow)])  # fmt: skip
 def test_the_hopper_on_its_planar_root_falls_and_rests_as_mujocos_does(dt):
     """Gymnasium's hopper dropped from its model pose with no control. Its root (slides x and z, hinge y) is one
-    PlanarJoint. Both engines tip it backwards onto its back, the leg and foot at their limits; the thigh and the
-    pitch differ by up to 0.25 rad because MuJoCo's joints carry armature 1 (rotor inertia), which a World's joints
-    leave out (without it MuJoCo's hopper rolls right over: the fall is that sensitive)."""
+    PlanarJoint; its thigh, leg and foot hinges keep their damping. Both engines tip it backwards onto its back, the
+    leg and foot at their limits; the thigh and the pitch differ by up to 0.15 rad because MuJoCo's joints carry
+    armature 1 (rotor inertia), which a World's joints leave out (without it MuJoCo's hopper rolls right over: the
+    fall is that sensitive)."""
     path = os.path.join(ASSETS, "hopper.xml")
     world = quiet_load(path)
     assert [j.kind for j in world.joints] == ["planar", "hinge", "hinge", "hinge"]
@@ -259,13 +261,16 @@ def test_the_hopper_on_its_planar_root_falls_and_rests_as_mujocos_does(dt):
     assert max(np.linalg.norm(b.velocity) for b in world.bodies) < 1e-3  # at rest (MuJoCo: 4e-3 rad/s)
     torso = bodies["torso"]
     assert abs(torso.position[1]) < 1e-9  # in its plane
-    _, _, pitch, thigh, leg, foot = data.qpos  # tumble at 500 Hz: x -0.166, z 0.191, pitch -2.357, thigh -0.634
-    x, _, z = data.xpos[model.body("torso").id]  # MuJoCo: -0.262, 0.174
-    assert torso.position[0] == pytest.approx(x, abs=0.15)
-    assert torso.position[2] == pytest.approx(z, abs=0.03)
-    assert _pitch(torso) == pytest.approx(pitch, abs=0.2)
+    # measured, tumble at 500 Hz: x -0.213, z 0.183, pitch -2.300, thigh -0.526; MuJoCo below: -0.262, 0.174, -2.226,
+    # -0.397 (without the damping, tumble's thigh rests at -0.634)
+    _, _, pitch, thigh, leg, foot = data.qpos
+    x, _, z = data.xpos[model.body("torso").id]
+    assert torso.position[0] == pytest.approx(x, abs=0.08)
+    assert torso.position[2] == pytest.approx(z, abs=0.015)
+    assert _pitch(torso) == pytest.approx(pitch, abs=0.12)
     angles = [j.angle for j in world.joints[1:]]
-    assert angles[0] == pytest.approx(thigh, abs=0.3)
+    assert angles[0] == pytest.approx(thigh, abs=0.2)
+    assert [j.damping for j in world.joints[1:]] == [1.0, 1.0, 1.0]
     np.testing.assert_allclose(angles[1:], [leg, foot], atol=0.01)  # both at a limit
     assert max(j.position_error for j in world.joints) < 1e-4
 
@@ -283,7 +288,7 @@ def test_the_humanoid_falls_and_rests_without_its_links_interpenetrating(dt):
     world.simulate(3.0, dt)  # at rest after 2.5 s at 240 Hz, 1 s at 500 Hz
     moving = [b for b in world.bodies if not b.is_static]
     assert max(np.linalg.norm(b.velocity) for b in moving) < 1e-3
-    assert 0.1 < world.bodies[0].position[2] < 0.6  # the torso has come down
+    assert 0.05 < world.bodies[0].position[2] < 0.6  # the torso has come down (lying, or sitting)
     contacts = world.contacts()
     assert len(contacts) > 4 and contacts.separation.min() > -5e-3  # no link into another or the floor by 5 mm
     assert max(j.position_error for j in world.joints) < 1e-4

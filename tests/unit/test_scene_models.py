@@ -16,7 +16,7 @@ PENDULUM = """<mujoco model="swing">
   <option timestep="0.005" gravity="0 0 -9.8"/>
   <worldbody>
     <geom name="floor" type="plane" size="5 5 0.1"/>
-    <body name="bob" pos="0 0 1"><joint name="pivot" axis="0 1 0" pos="0 0 0.5" damping="0.1"/>
+    <body name="bob" pos="0 0 1"><joint name="pivot" axis="0 1 0" pos="0 0 0.5" armature="0.1"/>
       <geom type="sphere" size="0.1" pos="0.3 0 0" mass="2"/></body>
   </worldbody>
   <actuator><motor name="push" joint="pivot" gear="2" ctrlrange="-1 1"/></actuator>
@@ -51,7 +51,7 @@ def folder(tmp_path):
 
 
 def test_a_scene_places_a_model_and_joins_its_bodies_by_name(folder):
-    with pytest.warns(UserWarning, match="joint damping are not simulated by a tumble World"):
+    with pytest.warns(UserWarning, match="a tumble World's joints do not simulate joint armature"):
         loaded = scene_file.load(folder / "scene.toml")
     world = loaded.world
     bob = next(b for b in world.bodies if b.name == "bob")
@@ -95,7 +95,7 @@ def test_tumble_run_and_info_take_a_model_file(folder):
     assert info.returncode == 0, info.stderr
     assert "bob" in info.stdout and "hinge" in info.stdout and "0.005" in info.stdout
     assert "actuators (1, world.ctrl)" in info.stdout and "push" in info.stdout and "[-1, 1]" in info.stdout
-    assert "tumble: " in info.stderr and "joint damping are not simulated" in info.stderr
+    assert "tumble: " in info.stderr and "do not simulate joint armature" in info.stderr
     assert "Traceback" not in info.stderr and "warn(" not in info.stderr
     run = tumble_cli("run", "parts/swing.xml", "--duration", "0.1", "--out", "swing.h5", "--quiet", cwd=folder)
     assert run.returncode == 0, run.stderr

@@ -10,7 +10,8 @@ solve, so that joint chains stay tight while they swing.
 Each joint is a *rigid block* of up to six rows, solved as one linear system (Cholesky of its effective mass,
 so that a hinge's anchor and axis rows do not fight each other as separate Gauss–Seidel blocks would), plus an
 optional *drive* along its free axis (hinge angle, slider translation, distance), solved first, row by row: a
-spring (always soft, its own frequency), a velocity motor with a bounded impulse, and one-sided limits
+spring (always soft, its own frequency) with the joint's damping (an absolute coefficient, MJCF's, implicit in the
+same row), a velocity motor with a bounded impulse, and one-sided limits
 (speculative when apart, as contacts are).
 
 Rows (world frame; ``r_a``, ``r_b`` the arms from each COM to its anchor, ``d = x_b + r_b − x_a − r_a``); each
@@ -61,7 +62,7 @@ from ..math3d import (
     sub,
 )
 from .contact_solver import _apply_impulse
-from .softness import soft_coefficients
+from .softness import soft_coefficients, spring_damper_coefficients
 
 __all__ = ["JointArrays", "JointKind", "joint_coordinates", "solve_joints", "warm_start_joints"]
 
@@ -81,7 +82,7 @@ class JointKind(IntEnum):
 
 
 # Columns of JointArrays.drive
-LOWER, UPPER, MOTOR_SPEED, MAX_MOTOR, SPRING_HERTZ, SPRING_RATIO, TARGET, CONE = 0, 1, 2, 3, 4, 5, 6, 7
+LOWER, UPPER, MOTOR_SPEED, MAX_MOTOR, SPRING_HERTZ, SPRING_RATIO, TARGET, CONE, DAMPING = 0, 1, 2, 3, 4, 5, 6, 7, 8
 # Columns of the drive impulses (state.joint_drive_impulse)
 SPRING, MOTOR, LOWER_LIMIT, UPPER_LIMIT, CONE_LIMIT = 0, 1, 2, 3, 4
 
@@ -98,13 +99,14 @@ class JointArrays(NamedTuple):
     local_anchor_b: np.ndarray  # (J, 3)
     local_frame_a: np.ndarray  # (J, 4) joint frame (x: the axis) relative to a's frame
     local_frame_b: np.ndarray  # (J, 4)
-    drive: np.ndarray  # (J, 8) lower, upper, motor speed, max motor torque/force, spring hertz, ratio, target, cone
+    drive: np.ndarray  # (J, 9) lower, upper, motor speed, max motor torque/force, spring hertz, ratio, target, cone,
+    # damping
 
     @classmethod
     def empty(cls) -> JointArrays:
         z = np.zeros
         return cls(z(0, np.int64), z(0, np.int64), z(0, np.int64), z((0, 3)), z((0, 3)), z((0, 4)), z((0, 4)),
-                   z((0, 8)))  # fmt: skip
+                   z((0, 9)))  # fmt: skip
 
 
 _ZERO33 = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
@@ -381,6 +383,7 @@ def _has_drive(joints, j, kind):
         limited
         or rod
         or joints.drive[j, SPRING_HERTZ] > 0.0
+        or joints.drive[j, DAMPING] > 0.0
         or joints.drive[j, MAX_MOTOR] > 0.0
         or (kind == BALL and joints.drive[j, CONE] < math.pi)
     )
@@ -477,16 +480,16 @@ def solve_joints(joints, impulses, inv_mass, inv_inertia_world, pos, quat, linve
             )
             pure_m = add(n, block_m) if angular else block_m
             lower, upper = joints.drive[j, LOWER], joints.drive[j, UPPER]
-            spring_hertz = joints.drive[j, SPRING_HERTZ]
+            spring_hertz, damping = joints.drive[j, SPRING_HERTZ], joints.drive[j, DAMPING]
             rigid_rod = kind == DISTANCE and spring_hertz == 0.0 and lower == upper
             for row in range(4):
                 if row == SPRING:
-                    if not (spring_hertz > 0.0 or rigid_rod):
+                    if not (spring_hertz > 0.0 or rigid_rod or (damping > 0.0 and mass > 0.0)):
                         continue
                     if rigid_rod:
                         sc = soft if use_bias else (0.0, 1.0, 0.0)
-                    else:
-                        sc = soft_coefficients(spring_hertz, joints.drive[j, SPRING_RATIO], h)
+                    else:  # the spring and the joint's damping, implicit together
+                        sc = spring_damper_coefficients(spring_hertz, joints.drive[j, SPRING_RATIO], damping, mass, h)
                     old = drive_impulse[j, SPRING]
                     rate = dot(dl, sub(vb, va)) - dot(da, wa) + dot(db, wb)
                     new = old - mass * sc[1] * (rate + sc[0] * (value - joints.drive[j, TARGET])) - sc[2] * old

@@ -18,7 +18,7 @@ import math
 
 from .._jit import inline
 
-__all__ = ["soft_coefficients"]
+__all__ = ["soft_coefficients", "spring_damper_coefficients"]
 
 
 @inline
@@ -31,3 +31,19 @@ def soft_coefficients(hertz, damping_ratio, h):
     a2 = h * omega * a1
     a3 = 1.0 / (1.0 + a2)
     return omega / a1, a2 * a3, a3
+
+
+@inline
+def spring_damper_coefficients(hertz, damping_ratio, damping, mass, h):
+    """The same for a joint's drive: a spring of ``hertz`` and ``damping_ratio`` relative to the effective mass
+    ``mass`` (``k = m ω²``, ``c = 2 m ζ ω``) plus an absolute damping ``damping`` [N s/m or N m s/rad] (MJCF's
+    joint ``damping``): with ``k/m = ω²`` and ``c/m = 2ζω + damping/m``, ``a2 = h (c/m + h k/m)``, ``a3 = 1/(1 +
+    a2)``, bias ``(k/m) / (c/m + h k/m)``. Without damping these are :func:`soft_coefficients`; without a spring,
+    an implicit damper, stable at any ``damping``."""
+    omega = 2.0 * math.pi * hertz if hertz > 0.0 else 0.0
+    stiffness_rate = omega * omega
+    damping_rate = 2.0 * damping_ratio * omega + (damping / mass if mass > 0.0 else 0.0)
+    a2 = h * (damping_rate + h * stiffness_rate)
+    a3 = 1.0 / (1.0 + a2)
+    bias = stiffness_rate / (damping_rate + h * stiffness_rate) if stiffness_rate > 0.0 else 0.0
+    return bias, a2 * a3, a3

@@ -154,9 +154,9 @@ def _joint(model, body, world_body, parent, anchor, rotation_quat):
         # travel) relative to its parent or, joined to the world, relative to the world: MuJoCo's sense both ways
         bounds = {"lower": joint.range[0] - joint.ref, "upper": joint.range[1] - joint.ref}
     if joint.type == "hinge":
-        return HingeJoint(a, b, anchor, axis, **bounds)
+        return HingeJoint(a, b, anchor, axis, damping=joint.damping, **bounds)
     if joint.type == "slide":
-        return SliderJoint(a, b, axis, anchor=anchor, **bounds)
+        return SliderJoint(a, b, axis, anchor=anchor, damping=joint.damping, **bounds)
     return BallJoint(a, b, anchor)
 
 
@@ -180,11 +180,13 @@ def _check(model: ModelDescription) -> set[str]:
         warnings.warn(f"{model.source}: actuators {', '.join(map(repr, driving))} are left out: their joints make a "
                       "planar joint, or a ball joint of hinges that are not orthonormal, which a World's actuators "
                       "do not drive (yet)", MJCFWarning, stacklevel=3)  # fmt: skip
+    # a body's one hinge or slide keeps its damping (its world joint's); the rest is left out
     notes = sorted({name for b in model.bodies for j in b.joints for name in ("damping", "armature", "stiffness",
-                    "frictionloss") if getattr(j, name)})  # fmt: skip
+                    "frictionloss") if getattr(j, name)
+                    and not (name == "damping" and len(b.joints) == 1 and j.type in ("hinge", "slide"))})  # fmt: skip
     if notes:
-        warnings.warn(f"{model.source}: joint {', '.join(notes)} are not simulated by a tumble World's joints (yet); "
-                      "ignored", MJCFWarning, stacklevel=3)  # fmt: skip
+        warnings.warn(f"{model.source}: a tumble World's joints do not simulate joint {', '.join(notes)} (yet; a "
+                      "body's one hinge or slide keeps its damping); ignored", MJCFWarning, stacklevel=3)  # fmt: skip
     return undriven
 
 

@@ -100,7 +100,7 @@ def _bounds(lower: float, upper: float, shift: float) -> dict:
 def joint_entry(joint, names: list[str]) -> dict:
     """A joint as its scene entry at the bodies' present poses (``names``: :func:`body_names`)."""
     spec = joint._world._builder.joints[joint.index]
-    lower, upper, speed, max_motor, hertz, ratio, target, cone = (float(v) for v in spec.drive)
+    lower, upper, speed, max_motor, hertz, ratio, target, cone, damping = (float(v) for v in spec.drive)
     a, b = joint.body_a, joint.body_b
     entry = {"type": joint.kind, "a": names[a.index], "b": None if b is None else names[b.index]}
     if spec.collide_connected:
@@ -122,6 +122,8 @@ def joint_entry(joint, names: list[str]) -> dict:
         shift = joint.angle if joint.kind == "hinge" else joint.translation
         entry.update(anchor=anchor, axis=axis, motor_speed=speed, spring_hertz=hertz, spring_damping_ratio=ratio,
                      spring_target=target - shift, **_bounds(lower, upper, shift))  # fmt: skip
+        if damping > 0.0:
+            entry["damping"] = damping
         entry["max_motor_torque" if joint.kind == "hinge" else "max_motor_force"] = max_motor
     elif joint.kind == "fixed":
         entry["anchor"] = anchor

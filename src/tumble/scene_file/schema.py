@@ -205,6 +205,7 @@ class _Drive(_Joint):
     spring_hertz: NonNegative = 0.0
     spring_damping_ratio: NonNegative = 0.0
     spring_target: Finite = 0.0
+    damping: NonNegative = 0.0
 
 
 class HingeJoint(_Drive):

@@ -203,7 +203,8 @@ def _joint_xml(world, child: int, parent: int, entry, qpos: list, qvel: list, dr
         low, high = sorted(ref + sense * np.array([entry.get("lower", -1e10), entry.get("upper", 1e10)]))
         bounds = f" range='{_num([low, high])}'"
     named = "" if name is None else f" name={quoteattr(name)} ref='{_num([ref])}'"
-    return f"<joint type='{kind}'{named} {local} axis='{_num(rotation_t @ axis)}'{bounds}/>"
+    damped = f" damping='{_num([entry['damping']])}'" if entry.get("damping", 0.0) > 0.0 else ""
+    return f"<joint type='{kind}'{named} {local} axis='{_num(rotation_t @ axis)}'{bounds}{damped}/>"
 
 
 def _loop_xml(world, entry, index: dict[str, int]) -> str:
