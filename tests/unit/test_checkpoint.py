@@ -201,6 +201,24 @@ def test_a_checkpoint_holds_no_pickle_and_refuses_tampering(tmp_path):
         tumble.World.load(tmp_path / "object.npz")
 
 
+def test_a_checkpoint_written_before_joint_damping_loads_undamped(tmp_path):
+    """Joints' drives grew a ninth column (damping) in issue 26: an eight-column drive reads as undamped."""
+    world = tumble.World()
+    bob = world.add_body(tumble.Sphere(0.1), mass=1.0, position=(1.0, 0.0, 0.0))
+    world.add_joint(tumble.HingeJoint(bob, None, (0, 0, 0), (0, 0, 1), damping=0.2))
+    world.save(tmp_path / "new.npz")
+    with np.load(tmp_path / "new.npz", allow_pickle=False) as data:
+        members = {k: data[k] for k in data.files}
+    manifest = json.loads(str(members.pop("manifest")))
+    drive = manifest["builder"]["fields"]["joints"][0]["fields"]["drive"]
+    assert drive["shape"] == [9] and drive["$small"][8] == 0.2
+    drive.update({"$small": drive["$small"][:8], "shape": [8]})
+    np.savez(tmp_path / "old.npz", manifest=np.array(json.dumps(manifest)), **members)
+    old = tumble.World.load(tmp_path / "old.npz")
+    assert old.joints[0].damping == 0.0 and tumble.World.load(tmp_path / "new.npz").joints[0].damping == 0.2
+    old.step(1 / 60)
+
+
 def test_save_and_load_refuse_the_wrong_files(tmp_path):
     world = scenes.box_pile(2)
     with pytest.raises(ValueError, match="checkpoints are .npz files"):
