@@ -334,3 +334,13 @@ def test_servos_on_merged_hinges_move_the_limbs_as_in_mujoco(xml):
         for body in world.bodies:
             np.testing.assert_allclose(body.position, data.xpos[model.body(body.name).id], rtol=0, atol=2e-3)
         np.testing.assert_allclose(world.actuator_forces(), data.actuator_force, rtol=0, atol=0.15)  # of up to 28 N
+
+
+def test_ranges_of_merged_hinges_are_named_in_a_warning_and_left_out():
+    xml = """<mujoco><worldbody><body name="arm">
+      <joint axis="1 0 0" range="-10 10"/>
+      <joint name="pitch" axis="0 1 0" range="-20 20"/>
+      <geom type="capsule" fromto="0 0 0 0 0 -1" size=".05"/></body></worldbody></mujoco>"""
+    with pytest.warns(tumble.models.mjcf.MJCFWarning, match=r"the ranges of joints 'line 2', 'pitch' are not enforced"):
+        world = tumble.load_mjcf(xml)
+    assert [j.kind for j in world.joints] == ["universal"]

@@ -167,7 +167,7 @@ def _check(model: ModelDescription) -> set[str]:
     for body in model.bodies:
         composite = _composite(model, body)
         if composite is not None:
-            limited += [j.name for j in body.joints if j.range is not None]
+            limited += [j.name or f"line {j.line}" for j in body.joints if j.range is not None]
         axes = np.array([j.axis for j in body.joints])
         if composite == "planar" or (composite == "ball" and not np.allclose(axes @ axes.T, np.eye(3), atol=1e-6)):
             undriven |= {j.name for j in body.joints}
