@@ -160,6 +160,11 @@ def _joint(model, body, world_body, parent, anchor, rotation_quat):
     return BallJoint(a, b, anchor)
 
 
+def _orthonormal(axes) -> bool:
+    axes = np.asarray(axes)
+    return bool(np.allclose(axes @ axes.T, np.eye(len(axes)), rtol=0.0, atol=1e-6))
+
+
 def _check(model: ModelDescription) -> set[str]:
     """Refuse what a World cannot hold, warn of what it leaves out; returns the names of the joints whose actuators
     are left out: those of a planar joint, and of a ball joint whose hinges are not orthonormal."""
@@ -168,8 +173,7 @@ def _check(model: ModelDescription) -> set[str]:
         composite = _composite(model, body)
         if composite is not None:
             limited += [j.name or f"line {j.line}" for j in body.joints if j.range is not None]
-        axes = np.array([j.axis for j in body.joints])
-        if composite == "planar" or (composite == "ball" and not np.allclose(axes @ axes.T, np.eye(3), atol=1e-6)):
+        if composite == "planar" or (composite == "ball" and not _orthonormal([j.axis for j in body.joints])):
             undriven |= {j.name for j in body.joints}
     if limited:
         warnings.warn(f"{model.source}: the ranges of joints {', '.join(map(repr, limited))} are not enforced: each "
