@@ -26,7 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from . import trajectory_io
-from ._validate import as_count, as_float, as_step, step_count
+from ._validate import as_count, as_float, step_count
 from .errors import SimulationError
 from .trajectory import Trajectory
 from .trajectory_io import FRAME_ARRAYS
@@ -325,7 +325,7 @@ def record(world, duration: float, dt: float, path, *, every: int = 1, chunk_fra
             chunk written before the interruption.
     """
     duration = as_float("duration", duration, positive=True)
-    dt = as_step("dt", dt, world.time)
+    dt = world._as_step(dt)
     n_steps = step_count(duration, dt)
     writer = TrajectoryWriter(path, world, every=every, chunk_frames=chunk_frames, scene=scene, dt=dt,
                               compression=compression)  # fmt: skip

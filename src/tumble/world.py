@@ -654,13 +654,24 @@ class World:
         """Advance one step of ``dt`` seconds. Applied forces act during this step only.
 
         Raises:
+            ValueError: ``dt`` does not advance the time, or its contacts would need more than 65 536 substeps
+                (``solver.substeps_for(dt)``); nothing has moved.
             SimulationError: the step produced a non-finite value; the world keeps its state from before, and the
                 loads applied for the step are dropped (so that the next step can succeed).
         """
-        dt = as_step("dt", dt, self._state.time)
+        dt = self._as_step(dt)
         failing = self._controlled_step(dt)
         if failing >= 0:
             raise self._simulation_error(failing)
+
+    def _as_step(self, dt) -> float:
+        """``dt`` checked as a step of this world: one that advances its time and, where the contact solver runs,
+        needs no more substeps than it allows (before any controller runs or state changes)."""
+        dt = as_step("dt", dt, self._state.time)
+        self._sync()
+        if self._model.has_constraints:
+            self._params.solver.substeps_for(dt)
+        return dt
 
     def _controlled_step(self, dt: float, flights=None) -> int:
         """The controllers that are due (or the compiled ``flights`` in their place), one step, the sensors'
@@ -706,7 +717,7 @@ class World:
         good state and the error's ``trajectory`` holds the frames recorded up to it.
         """
         duration = as_float("duration", duration, positive=True)
-        dt = as_step("dt", dt, self._state.time)
+        dt = self._as_step(dt)
         record_every = as_count("record_every", record_every)
         n_steps = step_count(duration, dt)
         self._sync()

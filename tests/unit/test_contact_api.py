@@ -104,6 +104,29 @@ def test_substeps_for_names_a_bad_step(dt):
         tumble.World().solver.substeps_for(dt)
 
 
+def test_a_step_that_needs_more_than_65536_contact_substeps_is_refused_before_anything_moves():
+    """A step of 1e5 s once asked for 4.8e7 substeps (minutes of work, uninterruptible); the cap names both knobs."""
+    assert tumble.World().solver.substeps_for(136.0) == 65280
+    with pytest.raises(ValueError, match=r"contact_hertz=60.0 at dt=137.0 needs 6.58e\+04 substeps"):
+        tumble.World().solver.substeps_for(137.0)
+    world, _, _ = resting_box()
+    seen = []
+    world.add_controller(lambda w, t: seen.append(t))
+    before = world.state.digest()
+    for dt in (137.0, 1e5, 1e300):
+        with pytest.raises(ValueError, match="dt="):
+            world.step(dt)
+        with pytest.raises(ValueError, match="dt="):
+            world.simulate(1e6, dt)
+    assert world.state.digest() == before and seen == []
+    assert tumble.World(contact_hertz=1.0).solver.substeps_for(1e3) == 8000  # softer contacts allow a longer step
+    # Bodies free of contacts and joints take no substeps: a long step is theirs to take.
+    free = tumble.World(gravity=(0, 0, 0))
+    ball = free.add_body(tumble.Sphere(0.1), mass=1.0, velocity=(1.0, 0, 0))
+    free.step(1e6)
+    assert ball.position[0] == pytest.approx(1e6)
+
+
 def test_solver_settings_are_validated():
     world = tumble.World(substeps=8, contact_hertz=60.0)
     assert world.solver.substeps == 8 and world.solver.contact_hertz == 60.0

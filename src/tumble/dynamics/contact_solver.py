@@ -26,7 +26,7 @@ from typing import NamedTuple
 import numpy as np
 
 from .._jit import inline, kernel
-from .._validate import MAX_COUNT, as_float
+from .._validate import as_float
 from ..geometry.manifold import MAX_POINTS
 from ..math3d import (
     add,
@@ -61,6 +61,10 @@ IMPACT_BLOCK_SWEEPS = 32
 # rate the contacts would be softer than asked, and a stack sags by (load / m_eff) g / ω² at each contact: the
 # ten-box tower toppled at 30 and 60 Hz with one substep and swayed 15-34 mm with four (issue 16).
 SUBSTEP_RATE_PER_CONTACT_HERTZ = 8.0
+# The most substeps the contact rule may add to one step (2**16, a step of 136 s at the default 60 Hz contacts, a
+# fifth of a second of work for one body): a longer step is likelier a unit slip (ms for s) than a wish, and would
+# hold the interpreter uninterruptibly for hours (a step of 1e6 s needed 4.8e8 substeps, half an hour for one box).
+MAX_CONTACT_SUBSTEPS = 2**16
 
 __all__ = ["ContactRows", "SolverSettings", "prepare_contacts", "solve_contacts", "warm_start_contacts"]
 
@@ -87,10 +91,10 @@ class SolverSettings(NamedTuple):
         contacts, 16 at 30 Hz, 1 from 480 Hz on)."""
         dt = as_float("dt", dt, positive=True)
         needed = dt * SUBSTEP_RATE_PER_CONTACT_HERTZ * self.contact_hertz * (1.0 - 1e-12)
-        if not needed <= MAX_COUNT:
+        if not needed <= MAX_CONTACT_SUBSTEPS:
             raise ValueError(
                 f"contact_hertz={self.contact_hertz!r} at dt={dt!r} needs {needed:.3g} substeps per step, more than "
-                f"{MAX_COUNT}: lower contact_hertz or dt"
+                f"{MAX_CONTACT_SUBSTEPS}: lower contact_hertz or dt"
             )
         return max(self.substeps, math.ceil(needed))
 
