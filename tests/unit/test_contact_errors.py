@@ -325,10 +325,11 @@ def test_a_force_whose_moment_overflows_is_refused():
     assert not world.inputs.body_torque.any()
 
 
-@pytest.mark.parametrize(("spin", "step"), [(1e160, 0), (1e100, 25)])
+@pytest.mark.parametrize(("spin", "step"), [(1e160, 0), (1e120, 25)])
 def test_a_runaway_body_is_named_even_when_it_takes_another_with_it(spin, step):
-    """1e160 rad/s overflows inside a kernel (a division by an infinite value); 1e100 rad/s lands on the ground
-    beside a calm box in the same step, and both turn NaN: the error names the spinner either way."""
+    """1e160 rad/s overflows inside a kernel (a division by an infinite value); 1e120 rad/s lands on the ground
+    beside a calm box in the same step, and both turn NaN: the error names the spinner either way. (1e100 rad/s
+    did too until the implicit spin kept the energy balance of its exact step; it now leaves at 1e96 m/s, finite.)"""
     world = tumble.World()
     world.add_static(tumble.Plane(), name="ground")
     world.add_body(tumble.Box((0.2, 0.2, 0.2)), mass=1.0, position=(0, 0, 1), name="calm")

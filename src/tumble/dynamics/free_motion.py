@@ -42,11 +42,14 @@ schemes, exact-to-fourth-order inside RK4.
 
 from __future__ import annotations
 
+import math
+
 from .._jit import inline
 from ..math3d import (
     add,
     add_scaled,
     cross,
+    dot,
     mat_vec,
     quat_add_scaled,
     quat_derivative,
@@ -108,7 +111,16 @@ def implicit_spin(q, w_body, inertia, torque, c_ang, h):
     tau_body = quat_rotate_inv(q, torque)
     residual = scale(sub(cross(w_body, mat_vec(inertia, w_body)), tau_body), h)
     w_new = sub(w_body, solve33(_gyroscopic_jacobian(inertia, w_body, h), residual))
-    return scale(w_new, 1.0 / (1.0 + h * c_ang))
+    # Dotted with ω', the exact solution's equation says ω'·Iω' = ω'·(Iω + h τ): the gyroscopic term does no work,
+    # and without torque the energy cannot rise (Cauchy–Schwarz in the I inner product). The one Newton step misses
+    # it by its residual and gained 7e-9 of the energy in a step of a thin box; scaling ω' by the s that restores
+    # the identity keeps the energy balance of the exact step (s = 1 + O(residual)).
+    i_new = mat_vec(inertia, w_new)
+    norm = dot(w_new, i_new)
+    s = dot(w_new, add_scaled(mat_vec(inertia, w_body), tau_body, h)) / norm if norm > 0.0 else 1.0
+    if not math.isfinite(s):
+        s = 1.0
+    return scale(w_new, s / (1.0 + h * c_ang))
 
 
 @inline
