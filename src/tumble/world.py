@@ -605,7 +605,8 @@ class World:
     def set_solver(self, **settings) -> None:
         """Change contact solver settings by name: ``substeps`` (int >= 1; a step takes more where contacts of
         ``contact_hertz`` need them, 8 per contact period, see ``solver.substeps_for(dt)``), ``contact_hertz`` (> 0),
-        ``contact_damping_ratio`` (>= 0), ``contact_push_max`` [m/s] (> 0), ``restitution_threshold`` [m/s] (>= 0),
+        ``contact_damping_ratio`` (>= 0), ``contact_push_max`` [m/s] (> 0; joint limits push a joint outside its range
+        back at most this fast too, in rad/s for angles), ``restitution_threshold`` [m/s] (>= 0),
         ``speculative_distance`` [m] (>= 0), ``sleep`` (bool), ``sleep_linear`` [m/s], ``sleep_angular`` [rad/s],
         ``time_to_sleep`` [s] (all >= 0), ``joint_hertz`` (> 0; capped at a quarter of the substep rate, and the
         default ``inf`` means that cap: 120 Hz at 60 Hz with 8 substeps) and ``joint_damping_ratio`` (>= 0), the

@@ -143,6 +143,37 @@ def test_hinge_limits_stop_a_pendulum():
     assert max(angles) > math.pi / 4 - 0.02
 
 
+@pytest.mark.parametrize("rate", [60, 240, 1000])
+@pytest.mark.parametrize("kind", ["hinge", "slider"])
+def test_a_joint_loaded_outside_its_range_is_brought_to_the_near_stop_and_left_at_rest(kind, rate):
+    """A 1 kg ball and a 1 kg rod, free in space, joined 30° (0.3 m) outside a 40° (0.4 m) range: the limit brings
+    them to the near stop, opening at contact_push_max (3 rad/s, 3 m/s) at most, and leaves them there: the slider
+    exactly, the hinge within 0.9° (the relax pass leaves 1.7 % of the push, 0.05 rad/s, until the pair sleeps),
+    the pair's momentum zero. Before the push was capped the hinge opened at over 100 rad/s, the relax pass left
+    1.5 rad/s of it and the rod swung on past the stop (50 rad/s in Gymnasium's ant: its ankles hit the far stops)."""
+    world = tumble.World(gravity=(0, 0, 0))
+    ball = world.add_body(tumble.Sphere(0.25), mass=1.0)
+    rod = world.add_body(tumble.Capsule(0.08, 0.4), mass=1.0, position=(0.28, 0, 0),
+                         orientation=(math.cos(math.pi / 4), 0, math.sin(math.pi / 4), 0))  # fmt: skip
+    if kind == "hinge":
+        joint = world.add_joint(tumble.HingeJoint(ball, rod, (0.08, 0, 0), (0, 1, 0), lower=math.radians(30),
+                                                  upper=math.radians(70)))  # fmt: skip
+        stop, overshoot, value_of, speed_of = math.radians(30), math.radians(1.5), "angle", "angular_speed"
+    else:
+        joint = world.add_joint(tumble.SliderJoint(ball, rod, (1, 0, 0), lower=0.3, upper=0.7))
+        stop, overshoot, value_of, speed_of = 0.3, 1e-9, "translation", "speed"
+    values, speeds = [], []
+    for _ in range(rate):  # one second
+        world.step(1 / rate)
+        values.append(getattr(joint, value_of))
+        speeds.append(getattr(joint, speed_of))
+    assert values[rate // 20 - 1] <= 3.0 * 0.05  # no faster than the cap over the first 0.05 s
+    assert stop - 1e-6 < max(values) < stop + overshoot  # at the near stop, not past it (30.9°, 0.3 m measured)
+    assert abs(speeds[-1]) < 1e-9  # at rest (asleep)
+    momentum = ball.linear_momentum + rod.linear_momentum
+    np.testing.assert_allclose(momentum, 0.0, atol=1e-12)
+
+
 def test_hinge_spring_holds_a_horizontal_bar_against_gravity_at_its_static_deflection():
     world = tumble.World()
     bar = world.add_body(tumble.Box((1.0, 0.05, 0.05)), mass=1.0, position=(0.5, 0.0, 0.0))

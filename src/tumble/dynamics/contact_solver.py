@@ -75,7 +75,7 @@ class SolverSettings(NamedTuple):
     substeps: int
     contact_hertz: float
     contact_damping_ratio: float
-    contact_push_max: float  # [m/s] largest push-out velocity
+    contact_push_max: float  # [m/s] largest push-out velocity (joint limits: m/s or rad/s)
     restitution_threshold: float  # [m/s] slower impacts do not bounce
     speculative_distance: float  # [m] contacts closer than this are created before touching
     sleep: bool  # let islands at rest sleep

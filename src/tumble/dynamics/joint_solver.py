@@ -215,13 +215,18 @@ def _axial_apply(angular, n, arm_a, rb, impulse, ma, ia, mb, ib, va, wa, vb, wb)
 
 
 @inline
-def _limit_impulse(old, mass, rate, c, inv_h, soft, use_bias):
-    """New accumulated impulse (>= 0) of a one-sided limit with position error ``c`` (>= 0 when satisfied)."""
+def _limit_impulse(old, mass, rate, c, inv_h, soft, push_max, use_bias):
+    """New accumulated impulse (>= 0) of a one-sided limit with position error ``c`` (>= 0 when satisfied).
+
+    A deep violation is pushed out at ``push_max`` at most (m/s or rad/s), as contacts are: at the joint's
+    stiffness a 30° violation opened at over 100 rad/s, and between two free bodies the relax pass, which can only
+    take back what the limit pushed, left up to 50 rad/s of it (the ant's ankles, loaded outside their range,
+    flew to their far stops)."""
     bias, m_scale, i_scale = 0.0, 1.0, 0.0
     if c > 0.0:
         bias = c * inv_h  # speculative: may close the gap within the substep, no faster
     elif use_bias:
-        bias, m_scale, i_scale = soft[0] * c, soft[1], soft[2]
+        bias, m_scale, i_scale = max(soft[0] * c, -push_max), soft[1], soft[2]
     return max(old - mass * m_scale * (rate + bias) - i_scale * old, 0.0)
 
 
@@ -440,8 +445,9 @@ def warm_start_joints(joints, impulses, inv_mass, inv_inertia_world, pos, quat, 
 
 @inline
 def solve_joints(joints, impulses, inv_mass, inv_inertia_world, pos, quat, linvel, angvel, h, joint_hertz,
-                 joint_damping_ratio, use_bias, force_total, moment_total):  # fmt: skip
-    """One Gauss–Seidel pass over the joints: drive, angular rows, point rows (soft when ``use_bias``).
+                 joint_damping_ratio, push_max, use_bias, force_total, moment_total):  # fmt: skip
+    """One Gauss–Seidel pass over the joints: drive, angular rows, point rows (soft when ``use_bias``); limits
+    push out at ``push_max`` at most.
 
     Writes: the accumulated impulses, velocities, and what each joint gave body ``b`` (the totals).
     """
@@ -508,14 +514,14 @@ def solve_joints(joints, impulses, inv_mass, inv_inertia_world, pos, quat, linve
                         continue
                     old = drive_impulse[j, LOWER_LIMIT]
                     rate = dot(dl, sub(vb, va)) - dot(da, wa) + dot(db, wb)
-                    new = _limit_impulse(old, mass, rate, value - lower, inv_h, soft, use_bias)
+                    new = _limit_impulse(old, mass, rate, value - lower, inv_h, soft, push_max, use_bias)
                     step = new - old
                 else:
                     if not (lower < upper and upper < math.inf):
                         continue
                     old = drive_impulse[j, UPPER_LIMIT]
                     rate = dot(dl, sub(vb, va)) - dot(da, wa) + dot(db, wb)
-                    new = _limit_impulse(old, mass, -rate, upper - value, inv_h, soft, use_bias)
+                    new = _limit_impulse(old, mass, -rate, upper - value, inv_h, soft, push_max, use_bias)
                     step = old - new  # the upper limit pushes against the axis
                 drive_impulse[j, row] = new
                 va, vb = add_scaled(va, dl, -ma * step), add_scaled(vb, dl, mb * step)
@@ -532,7 +538,7 @@ def solve_joints(joints, impulses, inv_mass, inv_inertia_world, pos, quat, linve
                 )  # fmt: skip
                 old = drive_impulse[j, CONE_LIMIT]
                 rate = dot(dl, sub(vb, va)) - dot(da, wa) + dot(db, wb)
-                new = _limit_impulse(old, mass, -rate, joints.drive[j, CONE] - swing, inv_h, soft, use_bias)
+                new = _limit_impulse(old, mass, -rate, joints.drive[j, CONE] - swing, inv_h, soft, push_max, use_bias)
                 step = old - new
                 drive_impulse[j, CONE_LIMIT] = new
                 va, vb = add_scaled(va, dl, -ma * step), add_scaled(vb, dl, mb * step)

@@ -110,13 +110,15 @@ def run_substeps(
         warm_start_contacts(rows, count, inv_mass, inv_inertia_world, pos, quat, pos0, quat0, linvel, angvel)
         if joints is not None:
             solve_joints(joints, joint_impulses, inv_mass, inv_inertia_world, pos, quat, linvel, angvel, h,
-                         joint_hertz, joint_damping_ratio, True, joint_force_total, joint_moment_total)  # fmt: skip
+                         joint_hertz, joint_damping_ratio, push_max, True, joint_force_total,
+                         joint_moment_total)  # fmt: skip
         solve_contacts(rows, count, inv_mass, inv_inertia_world, pos, quat, pos0, quat0, linvel, angvel, inv_h,
                        push_max, True, threshold)  # fmt: skip
         integrate_positions(moving, linvel, angvel, pos, quat, h)
         if joints is not None:
             solve_joints(joints, joint_impulses, inv_mass, inv_inertia_world, pos, quat, linvel, angvel, h,
-                         joint_hertz, joint_damping_ratio, False, joint_force_total, joint_moment_total)  # fmt: skip
+                         joint_hertz, joint_damping_ratio, push_max, False, joint_force_total,
+                         joint_moment_total)  # fmt: skip
         solve_contacts(rows, count, inv_mass, inv_inertia_world, pos, quat, pos0, quat0, linvel, angvel, inv_h,
                        push_max, False, threshold)  # fmt: skip
         accumulate_impulses(rows, count)
