@@ -42,6 +42,18 @@ def load_mjcf(path_or_xml, *, world=None, position=(0.0, 0.0, 0.0), orientation=
     return load(path_or_xml, world=world, position=position, orientation=orientation)
 
 
+def load_urdf(path, *, package_dirs=(), floating_base: bool = False, world=None, position=(0.0, 0.0, 0.0),
+              orientation=(1.0, 0.0, 0.0, 0.0)) -> World:  # fmt: skip
+    """A URDF robot in a world, as :func:`load_mjcf` loads an MJCF model: its links with their ``inertial`` and
+    ``collision`` shapes, its joints as the world's joints (``fixed`` ones weld a link to its parent), the root link
+    welded to the world, or free with ``floating_base=True``. ``package://`` mesh paths are looked up in
+    ``package_dirs``, then beside the file; see docs/model_files.md."""
+    from .models.build_world import load_urdf as load
+
+    return load(path, package_dirs=package_dirs, floating_base=floating_base, world=world, position=position,
+                orientation=orientation)  # fmt: skip
+
+
 def load_scene(path) -> World:
     """The world described by the scene file at ``path`` (TOML or JSON; see ``docs/scenes.md``)."""
     from .scene_file import load
@@ -82,6 +94,7 @@ __all__ = [
     "actuators",
     "control",
     "load_mjcf",
+    "load_urdf",
     "load_scene",
     "mass",
     "rotation",

@@ -33,6 +33,19 @@ def from_mjcf(path_or_xml) -> Articulation:
     return to_articulation(read_mjcf(path_or_xml))
 
 
+def from_urdf(path, *, package_dirs=(), floating_base: bool = False) -> Articulation:
+    """The articulation of a URDF robot: a link per URDF link with a moving joint (``fixed`` ones weld a link to its
+    parent), ``q`` in the order the links are met breadth first from the root; the root welded to the world, or
+    free with ``floating_base=True``; no contacts. A file that cannot be read raises
+    :class:`tumble.models.urdf.URDFError` naming the file, element and line. See docs/model_files.md."""
+    from ..models.build import to_articulation
+    from ..models.urdf import read_urdf
+
+    if not isinstance(floating_base, bool):
+        raise TypeError(f"floating_base must be True or False, got {floating_base!r}")
+    return to_articulation(read_urdf(path, package_dirs=package_dirs, floating_base=floating_base))
+
+
 __all__ = [
     "Actuator",
     "Articulation",
@@ -47,4 +60,5 @@ __all__ = [
     "Prismatic",
     "Revolute",
     "from_mjcf",
+    "from_urdf",
 ]

@@ -32,7 +32,7 @@ from ..shapes import Box, Capsule, ConvexHull, Cylinder, Plane, Sphere
 from .description import GeomDescription, ModelDescription
 from .mjcf import MJCFWarning
 
-__all__ = ["load_mjcf", "to_world"]
+__all__ = ["load_mjcf", "load_urdf", "to_world"]
 
 _IDENTITY = np.array([1.0, 0.0, 0.0, 0.0])
 
@@ -292,13 +292,31 @@ def to_world(model: ModelDescription, world=None, position=(0.0, 0.0, 0.0), orie
     return world
 
 
-def load_mjcf(path_or_xml, *, world=None, position=(0.0, 0.0, 0.0), orientation=_IDENTITY):
-    """``tumble.load_mjcf``: validate the placement, read the model, build it into ``world`` (or a new one)."""
+def _placement(world, position, orientation):
+    """The checked ``world``, ``position`` and ``orientation`` of a model loaded into a world."""
     from .._validate import as_quaternion, as_vector3
     from ..world import World
-    from .mjcf import read_mjcf
 
     if world is not None and not isinstance(world, World):
         raise TypeError(f"world must be a tumble.World or None, got {world!r}")
-    position, orientation = as_vector3("position", position), as_quaternion("orientation", orientation)
+    return world, as_vector3("position", position), as_quaternion("orientation", orientation)
+
+
+def load_mjcf(path_or_xml, *, world=None, position=(0.0, 0.0, 0.0), orientation=_IDENTITY):
+    """``tumble.load_mjcf``: validate the placement, read the model, build it into ``world`` (or a new one)."""
+    from .mjcf import read_mjcf
+
+    world, position, orientation = _placement(world, position, orientation)
     return to_world(read_mjcf(path_or_xml), world, position, orientation)
+
+
+def load_urdf(path, *, package_dirs=(), floating_base=False, world=None, position=(0.0, 0.0, 0.0),
+              orientation=_IDENTITY):  # fmt: skip
+    """``tumble.load_urdf``: as :func:`load_mjcf`, for a URDF file."""
+    from .urdf import read_urdf
+
+    if not isinstance(floating_base, bool):
+        raise TypeError(f"floating_base must be True or False, got {floating_base!r}")
+    world, position, orientation = _placement(world, position, orientation)
+    return to_world(read_urdf(path, package_dirs=package_dirs, floating_base=floating_base), world, position,
+                    orientation)  # fmt: skip

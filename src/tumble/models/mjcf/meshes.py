@@ -20,7 +20,7 @@ from .attributes import numbers
 from .mesh_inertia import convex_hull_faces
 from .xml import Node
 
-__all__ = ["MESH_ATTRIBUTES", "MESH_COSMETIC", "read_mesh"]
+__all__ = ["MESH_ATTRIBUTES", "MESH_COSMETIC", "read_mesh", "read_mesh_file"]
 
 MESH_ATTRIBUTES = {"name", "class", "file", "vertex", "face", "scale", "refpos", "refquat", "inertia"}
 # what only drawing or collision uses: read past
@@ -61,6 +61,18 @@ def _read_with_trimesh(node: Node, path: Path) -> tuple[np.ndarray, np.ndarray]:
     return np.asarray(mesh.vertices, dtype=np.float64), np.asarray(mesh.faces, dtype=np.int64)
 
 
+def read_mesh_file(node: Node, path: Path) -> tuple[np.ndarray, np.ndarray]:
+    """The vertices and triangles of an STL, OBJ or MSH file that ``node`` names, checked."""
+    if path.suffix.lower() not in (".stl", ".obj", ".msh"):
+        raise node.error(f"file={path.name!r}: a mesh file is .stl, .obj or .msh")
+    vertices, faces = (_read_msh if path.suffix.lower() == ".msh" else _read_with_trimesh)(node, path)
+    if len(vertices) < 4 or not np.all(np.isfinite(vertices)):
+        raise node.error(f"{path}: a mesh needs at least four finite vertices, found {len(vertices)}")
+    if np.any((faces < 0) | (faces >= len(vertices))):
+        raise node.error(f"{path}: faces index vertices outside 0..{len(vertices) - 1}")
+    return vertices, faces
+
+
 def _file_path(node: Node, name: str, directory: Path, strip: bool) -> Path:
     file = Path(name)
     if strip:
@@ -70,8 +82,6 @@ def _file_path(node: Node, name: str, directory: Path, strip: bool) -> Path:
         raise node.error(f"file={name!r} leaves the mesh directory {directory}")
     if not path.is_file():
         raise node.error(f"file={name!r}: no such mesh file ({path})")
-    if path.suffix.lower() not in (".stl", ".obj", ".msh"):
-        raise node.error(f"file={name!r}: a mesh file is .stl, .obj or .msh")
     return path
 
 
@@ -102,11 +112,7 @@ def read_mesh(node: Node, attrib: dict[str, str], directory: Path, strip: bool) 
         raise node.error("a mesh takes its vertices from a file or from vertex=..., one of the two")
     if "file" in attrib:
         path = _file_path(node, attrib["file"], directory, strip)
-        vertices, faces = (_read_msh if path.suffix.lower() == ".msh" else _read_with_trimesh)(node, path)
-        if len(vertices) < 4 or not np.all(np.isfinite(vertices)):
-            raise node.error(f"{path}: a mesh needs at least four finite vertices, found {len(vertices)}")
-        if np.any((faces < 0) | (faces >= len(vertices))):
-            raise node.error(f"{path}: faces index vertices outside 0..{len(vertices) - 1}")
+        vertices, faces = read_mesh_file(node, path)
         source, name = str(path), attrib.get("name", path.stem)
     else:
         vertices, faces = _written(node, attrib)

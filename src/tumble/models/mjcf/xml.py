@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from xml.parsers import expat
 
-__all__ = ["MJCFError", "Node", "read_model"]
+__all__ = ["MJCFError", "Node", "parse_xml", "read_model"]
 
 
 class MJCFError(ValueError):
@@ -36,7 +36,8 @@ class Node:
         return MJCFError(f"{self.where()}: {message}")
 
 
-def _parse(text: str | bytes, source: str) -> Node:
+def parse_xml(text: str | bytes, source: str, root_tag: str) -> Node:
+    """The tree of an XML document whose root element is ``<root_tag>`` (MJCF's ``mujoco``, URDF's ``robot``)."""
     parser = expat.ParserCreate()
     stack: list[Node] = []
     roots: list[Node] = []
@@ -53,8 +54,8 @@ def _parse(text: str | bytes, source: str) -> Node:
     except expat.ExpatError as error:
         raise MJCFError(f"{source}, line {error.lineno}: malformed XML ({expat.ErrorString(error.code)})") from None
     root = roots[0]
-    if root.tag != "mujoco":
-        raise root.error("the root element must be <mujoco>")
+    if root.tag != root_tag:
+        raise root.error(f"the root element must be <{root_tag}>")
     return root
 
 
@@ -63,13 +64,13 @@ def read_model(path_or_xml: str | os.PathLike) -> tuple[Node, Path]:
     and the directory that relative paths start from (the file's, or the working directory for text)."""
     if isinstance(path_or_xml, str) and path_or_xml.lstrip().startswith("<"):
         base, chain = Path.cwd().resolve(), ["<string>"]
-        root = _parse(path_or_xml, "<string>")
+        root = parse_xml(path_or_xml, "<string>", "mujoco")
     else:
         path = Path(path_or_xml)
         if not path.is_file():
             raise MJCFError(f"{path}: no such model file")
         base, chain = path.resolve().parent, [str(path.resolve())]
-        root = _parse(path.read_bytes(), str(path))
+        root = parse_xml(path.read_bytes(), str(path), "mujoco")
     _expand_includes(root, base, base, chain)
     return root, base
 
@@ -111,4 +112,4 @@ def _included(child: Node, model_dir: Path, here: Path, chain: list[str]) -> tup
         raise child.error(f"include file={name!r} includes itself (through {' -> '.join(chain)})")
     if not target.is_file():
         raise child.error(f"include file={name!r}: no such file ({target})")
-    return _parse(target.read_bytes(), str(target)), target
+    return parse_xml(target.read_bytes(), str(target), "mujoco"), target
