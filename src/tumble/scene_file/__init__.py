@@ -141,13 +141,15 @@ def from_dict(data: dict, *, base: Path | str = ".", label: str = "<scene>") -> 
 
 
 def _model_scene(path: Path) -> LoadedScene:
-    """A model file (MJCF) as a scene of that one model, with its gravity and its timestep as the step."""
+    """A model file (MJCF or URDF) as a scene of that one model, with its gravity and its timestep as the step (a
+    URDF has neither: MuJoCo's defaults, 9.81 m/s² down and 2 ms)."""
     from ..models.mjcf import MJCFError, read_mjcf
+    from ..models.urdf import read_urdf
 
     try:
         with warnings.catch_warnings():  # read for its options only; building it reads it again, and warns
             warnings.simplefilter("ignore")
-            model = read_mjcf(path)
+            model = read_urdf(path) if path.suffix.lower() == ".urdf" else read_mjcf(path)
     except (MJCFError, OSError) as error:
         raise SceneError(str(error)) from None
     data = {"world": {"gravity": model.gravity.tolist(), "dt": float(model.timestep)}, "models": [{"path": path.name}]}
@@ -155,13 +157,15 @@ def _model_scene(path: Path) -> LoadedScene:
 
 
 def load(path) -> LoadedScene:
-    """Read, validate and build the scene file at ``path`` (``.toml`` or ``.json``, or an MJCF model: ``.xml``)."""
+    """Read, validate and build the scene file at ``path`` (``.toml`` or ``.json``, or a model file: MJCF ``.xml``,
+    URDF ``.urdf``)."""
     path = Path(path)
     label = path.name
-    if path.suffix.lower() == ".xml":
+    if path.suffix.lower() in (".xml", ".urdf"):
         return _model_scene(path)
     if path.suffix not in (".toml", ".json"):
-        raise SceneError(f"{label}: a scene file must end in .toml or .json (or be an MJCF model, .xml)")
+        raise SceneError(f"{label}: a scene file must end in .toml or .json (or be a model file: MJCF .xml, URDF "
+                         ".urdf)")  # fmt: skip
     try:
         text = path.read_bytes().decode("utf-8-sig")  # a byte-order mark, as some editors write, is skipped
     except OSError as error:

@@ -168,17 +168,25 @@ def _vehicles(world, specs, label: str) -> dict:
 
 def _model(world: World, spec: schema.Model, base: Path, place: str, label: str) -> dict:
     """Load the model file ``spec`` names into ``world``; its named bodies, for the scene's joints."""
-    from ..models.build_world import load_mjcf
+    from ..models.build_world import load_mjcf, load_urdf
     from ..models.mjcf import MJCFError
 
     path = (base / spec.path).resolve()
     if not path.is_file():
         raise SceneError(f"{label}: {place}.path: no model file {spec.path!r} (looked for {path})")
-    if path.suffix.lower() != ".xml":
-        raise SceneError(f"{label}: {place}.path: a model file is MJCF, ending in .xml; got {spec.path!r}")
+    kind = path.suffix.lower()
+    if kind not in (".xml", ".urdf"):
+        raise SceneError(f"{label}: {place}.path: a model file is MJCF (.xml) or URDF (.urdf); got {spec.path!r}")
+    if kind == ".xml" and (spec.floating_base is not None or spec.package_dirs is not None):
+        raise SceneError(f"{label}: {place}: floating_base and package_dirs are a URDF's; {spec.path!r} is MJCF")
     before = len(world.bodies)
     try:
-        load_mjcf(path, world=world, position=spec.position, orientation=spec.orientation)
+        if kind == ".urdf":
+            load_urdf(path, package_dirs=[base / d for d in spec.package_dirs or ()],
+                      floating_base=bool(spec.floating_base), world=world, position=spec.position,
+                      orientation=spec.orientation)  # fmt: skip
+        else:
+            load_mjcf(path, world=world, position=spec.position, orientation=spec.orientation)
     except (MJCFError, ValueError, TypeError) as error:
         raise SceneError(f"{label}: {place}: {error}") from None
     return {body.name: body for body in world.bodies[before:] if body.name is not None}

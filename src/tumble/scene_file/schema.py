@@ -302,12 +302,16 @@ class Articulation(_Strict):
 
 
 class Model(_Strict):
-    """A model file (MJCF) put into the world with ``tumble.load_mjcf``: ``path`` relative to the scene file, the
-    whole model at ``position``/``orientation``; its bodies keep the model's names (scene joints may refer to them)."""
+    """A model file put into the world: MJCF (``.xml``) with ``tumble.load_mjcf``, URDF (``.urdf``) with
+    ``tumble.load_urdf``; ``path`` relative to the scene file, the whole model at ``position``/``orientation``; its
+    bodies keep the model's names (scene joints may refer to them). A URDF's ``floating_base`` frees its root link,
+    and its ``package://`` meshes are looked up in ``package_dirs`` (relative to the scene file) first."""
 
     path: Path
     position: Vector3 = (0.0, 0.0, 0.0)
     orientation: Quaternion = (1.0, 0.0, 0.0, 0.0)
+    floating_base: bool | None = None  # a URDF's root free (None: welded, as False)
+    package_dirs: list[Path] | None = None
 
 
 # --- vehicles and wind (docs/quadrotor.md) ----------------------------------------------------------------
