@@ -111,6 +111,10 @@ def test_what_is_not_simulated_is_warned_about_and_arguments_are_checked(tmp_pat
                   + "\n" + _hinge("m", "a", "c", '<mimic joint="j" multiplier="2"/>'))  # fmt: skip
     with pytest.warns(URDFWarning, match=r"robot\.urdf, line 6, <joint>: joint 'm': <mimic> is not simulated"):
         read_urdf(path)
+    dry = _robot(tmp_path, _link("a") + "\n" + _link("b") + "\n" + _hinge("j", "a", "b", '<dynamics friction="0.3"/>'),
+                 "dry.urdf")  # fmt: skip
+    with pytest.warns(URDFWarning, match=r"dry\.urdf, line 4, <dynamics>: joint 'j': friction=0.3 \(dry friction\)"):
+        from_urdf(dry)
     with pytest.raises(TypeError, match="floating_base must be True or False, got 'yes'"):
         tumble.load_urdf(path, floating_base="yes")
     with pytest.raises(TypeError, match="floating_base"):

@@ -232,6 +232,9 @@ def _joint(node: Node, links: dict[str, Node]) -> tuple[str, str, JointDescripti
     friction = 0.0 if dynamics is None else _number(dynamics, "friction", 0.0)
     if damping < 0.0 or friction < 0.0:
         raise _error(dynamics, f"joint {name!r}: damping and friction must be >= 0")
+    if friction > 0.0:
+        warnings.warn(f"{dynamics.where()}: joint {name!r}: friction={friction!r} (dry friction) is not simulated "
+                      "(yet); ignored", URDFWarning, stacklevel=4)  # fmt: skip
     if _child(node, "mimic") is not None:
         warnings.warn(f"{node.where()}: joint {name!r}: <mimic> is not simulated (yet); the joint moves freely",
                       URDFWarning, stacklevel=4)  # fmt: skip
