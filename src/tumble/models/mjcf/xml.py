@@ -28,22 +28,24 @@ class Node:
     file: str
     line: int
     children: list[Node] = field(default_factory=list)
+    error_type: type[MJCFError] = MJCFError  # the format's error (URDF's is a subclass)
 
     def where(self) -> str:
         return f"{self.file}, line {self.line}, <{self.tag}>"
 
     def error(self, message: str) -> MJCFError:
-        return MJCFError(f"{self.where()}: {message}")
+        return self.error_type(f"{self.where()}: {message}")
 
 
-def parse_xml(text: str | bytes, source: str, root_tag: str) -> Node:
-    """The tree of an XML document whose root element is ``<root_tag>`` (MJCF's ``mujoco``, URDF's ``robot``)."""
+def parse_xml(text: str | bytes, source: str, root_tag: str, error_type: type[MJCFError] = MJCFError) -> Node:
+    """The tree of an XML document whose root element is ``<root_tag>`` (MJCF's ``mujoco``, URDF's ``robot``); its
+    nodes' errors are ``error_type``."""
     parser = expat.ParserCreate()
     stack: list[Node] = []
     roots: list[Node] = []
 
     def start(tag, attrib):
-        node = Node(tag, dict(attrib), source, parser.CurrentLineNumber)
+        node = Node(tag, dict(attrib), source, parser.CurrentLineNumber, error_type=error_type)
         (stack[-1].children if stack else roots).append(node)
         stack.append(node)
 
@@ -52,7 +54,7 @@ def parse_xml(text: str | bytes, source: str, root_tag: str) -> Node:
     try:
         parser.Parse(text, True)
     except expat.ExpatError as error:
-        raise MJCFError(f"{source}, line {error.lineno}: malformed XML ({expat.ErrorString(error.code)})") from None
+        raise error_type(f"{source}, line {error.lineno}: malformed XML ({expat.ErrorString(error.code)})") from None
     root = roots[0]
     if root.tag != root_tag:
         raise root.error(f"the root element must be <{root_tag}>")

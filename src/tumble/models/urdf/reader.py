@@ -22,6 +22,7 @@ from ...mass import MassProperties
 from ...rotation import quat_from_axis_angle, quat_multiply
 from ..description import BodyDescription, GeomDescription, JointDescription, MeshDescription, ModelDescription
 from ..mjcf import MJCFError, MJCFWarning
+from ..mjcf.attributes import numbers
 from ..mjcf.mesh_inertia import convex_hull_faces
 from ..mjcf.meshes import read_mesh_file
 from ..mjcf.xml import Node, parse_xml
@@ -43,23 +44,11 @@ class URDFWarning(MJCFWarning):
     """Something in a URDF file that tumble reads past or does not simulate (a subclass of ``MJCFWarning``)."""
 
 
-def _error(node: Node, message: str) -> URDFError:
-    return URDFError(f"{node.where()}: {message}")
-
-
 def _numbers(node: Node, name: str, count: int, default=None) -> np.ndarray:
-    text = node.attrib.get(name)
-    if text is None:
-        if default is None:
-            raise _error(node, f"needs {name}= ({count} numbers)")
-        return np.array(default, dtype=float)
-    try:
-        values = np.array([float(word) for word in text.split()], dtype=float)
-    except ValueError:
-        raise _error(node, f"{name}={text!r} is not a list of numbers") from None
-    if values.size != count or not np.all(np.isfinite(values)):
-        raise _error(node, f"{name}={text!r} must be {count} finite number{'s' if count > 1 else ''}")
-    return values
+    """``count`` finite numbers of ``name``, else ``default``; refused by name when missing without one."""
+    if name not in node.attrib and default is None:
+        raise node.error(f"needs {name}= ({count} numbers)")
+    return numbers(node, node.attrib, name, count, default)
 
 
 def _number(node: Node, name: str, default: float | None = None) -> float:
@@ -74,7 +63,7 @@ def _child(node: Node, tag: str) -> Node | None:
     """The one ``<tag>`` child of ``node``, or None; two are refused."""
     found = _children(node, tag)
     if len(found) > 1:
-        raise _error(found[1], f"a <{node.tag}> takes one <{tag}>")
+        raise found[1].error(f"a <{node.tag}> takes one <{tag}>")
     return found[0] if found else None
 
 
@@ -102,28 +91,28 @@ def _mass_properties(link: Node) -> MassProperties | None:
         return None
     mass_node, inertia_node = _child(inertial, "mass"), _child(inertial, "inertia")
     if mass_node is None:
-        raise _error(inertial, f"link {link.attrib.get('name')!r}: an <inertial> needs a <mass>")
+        raise inertial.error(f"link {link.attrib.get('name')!r}: an <inertial> needs a <mass>")
     mass = _number(mass_node, "value")
     if mass < 0.0:
-        raise _error(mass_node, f"link {link.attrib.get('name')!r}: value={mass!r} must be >= 0")
+        raise mass_node.error(f"link {link.attrib.get('name')!r}: value={mass!r} must be >= 0")
     if mass == 0.0:
         return None
     if inertia_node is None:
-        raise _error(inertial, f"link {link.attrib.get('name')!r}: an <inertial> needs an <inertia>")
+        raise inertial.error(f"link {link.attrib.get('name')!r}: an <inertial> needs an <inertia>")
     xx, xy, xz, yy, yz, zz = (_number(inertia_node, key) for key in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz"))
     tensor = np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]])
     com, quat = _origin(inertial)
     try:
         local = MassProperties(mass, np.zeros(3), tensor)
     except ValueError as error:
-        raise _error(inertia_node, f"link {link.attrib.get('name')!r}: a non-physical inertia: {error}") from None
+        raise inertia_node.error(f"link {link.attrib.get('name')!r}: a non-physical inertia: {error}") from None
     # MassProperties forgives 1 % of the trace (round-off of meshes); a tensor written by hand gets the last digits'
     # worth, as MuJoCo refuses these files (pybullet_data's mini_cheetah and TwoJointRobot fail it by 0.4-3 %)
     moments = np.linalg.eigvalsh(tensor)
     if moments[0] + moments[1] < moments[2] - 1e-6 * moments.sum():
-        raise _error(inertia_node, f"link {link.attrib.get('name')!r}: a non-physical inertia: its principal moments "
-                                   f"{np.array2string(moments, precision=6)} fail the triangle inequality "
-                                   f"I1 + I2 >= I3 (by {moments[2] - moments[0] - moments[1]:.3g} kg m²)")  # fmt: skip
+        raise inertia_node.error(f"link {link.attrib.get('name')!r}: a non-physical inertia: its principal moments "
+                                 f"{np.array2string(moments, precision=6)} fail the triangle inequality "
+                                 f"I1 + I2 >= I3 (by {moments[2] - moments[0] - moments[1]:.3g} kg m²)")  # fmt: skip
     return local.transformed(rotation=quat, translation=com)
 
 
@@ -139,11 +128,11 @@ def _package_path(node: Node, name: str, base: Path, package_dirs: tuple[Path, .
             if path.is_file():
                 return path
         searched = ", ".join(str(d) for d in [*package_dirs, base])
-        raise _error(node, f"filename={name!r}: package {package!r} not found (package_dirs and the file's folder "
-                           f"and its parents searched: {searched})")  # fmt: skip
+        raise node.error(f"filename={name!r}: package {package!r} not found (package_dirs and the file's folder "
+                         f"and its parents searched: {searched})")  # fmt: skip
     path = Path(name[len("file://") :]) if name.startswith("file://") else base / name
     if not path.is_file():
-        raise _error(node, f"filename={name!r}: no such mesh file ({path})")
+        raise node.error(f"filename={name!r}: no such mesh file ({path})")
     return path
 
 
@@ -151,7 +140,7 @@ def _geometry(link: Node, collision: Node, index: int, base: Path, package_dirs,
     geometry = _child(collision, "geometry")
     shapes = [] if geometry is None else geometry.children
     if len(shapes) != 1:
-        raise _error(geometry or collision, "a <collision> needs a <geometry> with one shape")
+        raise (geometry or collision).error("a <collision> needs a <geometry> with one shape")
     shape = shapes[0]
     pos, quat = _origin(collision)
     size, mesh = np.zeros(3), None
@@ -164,25 +153,22 @@ def _geometry(link: Node, collision: Node, index: int, base: Path, package_dirs,
     elif shape.tag == "mesh":
         name = shape.attrib.get("filename")
         if not name:
-            raise _error(shape, "a <mesh> needs a filename")
+            raise shape.error("a <mesh> needs a filename")
         path = _package_path(shape, name, base, package_dirs)
         scale = _numbers(shape, "scale", 3, [1.0, 1.0, 1.0])
         mesh = f"{link.attrib['name']}/collision{index}"
         meshes[mesh] = _mesh(shape, path, scale, mesh)
     else:
-        raise _error(shape, f"<{shape.tag}> is not a URDF shape: box, cylinder, sphere or mesh")
+        raise shape.error(f"<{shape.tag}> is not a URDF shape: box, cylinder, sphere or mesh")
     if np.any(size[: {"box": 3, "sphere": 1}.get(shape.tag, 2)] <= 0.0) and mesh is None:
-        raise _error(shape, "a shape's sizes must be > 0")
+        raise shape.error("a shape's sizes must be > 0")
     friction = np.array([1.0, 0.005, 0.0001])  # MuJoCo's defaults, as its URDF import gives every geom
     return GeomDescription(collision.attrib.get("name"), shape.tag, size, pos, quat, 0, 1, 1, friction, shape.line,
                            mesh)  # fmt: skip
 
 
 def _mesh(node: Node, path: Path, scale: np.ndarray, name: str) -> MeshDescription:
-    try:
-        vertices, faces = read_mesh_file(node, path)
-    except MJCFError as error:
-        raise URDFError(str(error)) from None
+    vertices, faces = read_mesh_file(node, path)
     vertices = vertices.astype(np.float32).astype(np.float64) * scale
     if np.prod(scale) < 0.0:
         faces = faces[:, ::-1]
@@ -195,20 +181,20 @@ def _joint(node: Node, links: dict[str, Node]) -> tuple[str, str, JointDescripti
     """``(parent, child, joint or None for fixed, origin position, origin quaternion)`` of one ``<joint>``."""
     name, kind = node.attrib.get("name"), node.attrib.get("type")
     if not name:
-        raise _error(node, "a <joint> needs a name")
+        raise node.error("a <joint> needs a name")
     if kind == "planar":
-        raise _error(node, f"joint {name!r}: type='planar' is not supported (a World's PlanarJoint is the motion in a "
-                           "plane through a point, which URDF's planar joint does not fix); use two prismatic joints "
-                           "and a revolute")  # fmt: skip
+        raise node.error(f"joint {name!r}: type='planar' is not supported (a World's PlanarJoint is the motion in a "
+                         "plane through a point, which URDF's planar joint does not fix); use two prismatic joints "
+                         "and a revolute")  # fmt: skip
     if kind not in _JOINT_TYPES:
-        raise _error(node, f"joint {name!r}: type={kind!r} must be one of {', '.join(_JOINT_TYPES)}")
+        raise node.error(f"joint {name!r}: type={kind!r} must be one of {', '.join(_JOINT_TYPES)}")
     ends = []
     for tag in ("parent", "child"):
         element = _child(node, tag)
         if element is None or not element.attrib.get("link"):
-            raise _error(node, f"joint {name!r} needs a <{tag} link=...>")
+            raise node.error(f"joint {name!r} needs a <{tag} link=...>")
         if element.attrib["link"] not in links:
-            raise _error(element, f"joint {name!r}: no link named {element.attrib['link']!r}")
+            raise element.error(f"joint {name!r}: no link named {element.attrib['link']!r}")
         ends.append(element.attrib["link"])
     pos, quat = _origin(node)
     if _JOINT_TYPES[kind] in (None, "free", "ball"):
@@ -219,19 +205,19 @@ def _joint(node: Node, links: dict[str, Node]) -> tuple[str, str, JointDescripti
     axis = np.array([1.0, 0.0, 0.0]) if axis_node is None else _numbers(axis_node, "xyz", 3)
     norm = float(np.linalg.norm(axis))
     if norm < 1e-12:
-        raise _error(axis_node, f"joint {name!r}: axis xyz={axis_node.attrib['xyz']!r} has no direction")
+        raise axis_node.error(f"joint {name!r}: axis xyz={axis_node.attrib['xyz']!r} has no direction")
     joint_range = None
     limit = _child(node, "limit")
     if kind != "continuous" and limit is not None:
         lower, upper = _number(limit, "lower", 0.0), _number(limit, "upper", 0.0)
         if lower > upper:
-            raise _error(limit, f"joint {name!r}: lower={lower!r} is above upper={upper!r}")
+            raise limit.error(f"joint {name!r}: lower={lower!r} is above upper={upper!r}")
         joint_range = (lower, upper) if lower < upper else None  # MuJoCo too leaves lower == upper unlimited
     dynamics = _child(node, "dynamics")
     damping = 0.0 if dynamics is None else _number(dynamics, "damping", 0.0)
     friction = 0.0 if dynamics is None else _number(dynamics, "friction", 0.0)
     if damping < 0.0 or friction < 0.0:
-        raise _error(dynamics, f"joint {name!r}: damping and friction must be >= 0")
+        raise dynamics.error(f"joint {name!r}: damping and friction must be >= 0")
     if friction > 0.0:
         warnings.warn(f"{dynamics.where()}: joint {name!r}: friction={friction!r} (dry friction) is not simulated "
                       "(yet); ignored", URDFWarning, stacklevel=4)  # fmt: skip
@@ -254,11 +240,8 @@ def read_urdf(path: str | os.PathLike, *, package_dirs=(), floating_base: bool =
     file = Path(path)
     if not file.is_file():
         raise URDFError(f"{file}: no such URDF file")
-    try:
-        # a trailing NUL (pybullet_data's humanoid.urdf ends in one) is past the document: MuJoCo reads it too
-        root = parse_xml(file.read_bytes().rstrip(b"\x00"), str(file), "robot")
-    except MJCFError as error:
-        raise URDFError(str(error)) from None
+    # a trailing NUL (pybullet_data's humanoid.urdf ends in one) is past the document: MuJoCo reads it too
+    root = parse_xml(file.read_bytes().rstrip(b"\x00"), str(file), "robot", URDFError)
     if isinstance(package_dirs, (str, os.PathLike)):
         package_dirs = (package_dirs,)
     package_dirs = tuple(Path(d) for d in package_dirs)
@@ -267,23 +250,23 @@ def read_urdf(path: str | os.PathLike, *, package_dirs=(), floating_base: bool =
     for link in _children(root, "link"):
         name = link.attrib.get("name")
         if not name:
-            raise _error(link, "a <link> needs a name")
+            raise link.error("a <link> needs a name")
         if name in links:
-            raise _error(link, f"link {name!r} is defined twice (first on line {links[name].line})")
+            raise link.error(f"link {name!r} is defined twice (first on line {links[name].line})")
         links[name] = link
     if not links:
-        raise _error(root, "a robot needs at least one <link>")
+        raise root.error("a robot needs at least one <link>")
     parent_of: dict[str, tuple[str, JointDescription | None, np.ndarray, np.ndarray, Node]] = {}
     for node in _children(root, "joint"):
         parent, child, joint, pos, quat = _joint(node, links)
         if child in parent_of:
-            raise _error(node, f"link {child!r} has two parents: joints {parent_of[child][4].attrib['name']!r} and "
-                               f"{node.attrib['name']!r}")  # fmt: skip
+            raise node.error(f"link {child!r} has two parents: joints {parent_of[child][4].attrib['name']!r} and "
+                             f"{node.attrib['name']!r}")  # fmt: skip
         parent_of[child] = (parent, joint, pos, quat, node)
     roots = [name for name in links if name not in parent_of]
     if len(roots) != 1:
         detail = "every link is some joint's child: the joints make a loop" if not roots else ", ".join(roots)
-        raise _error(root, f"a robot is a tree with one root link; found {len(roots)} ({detail})")
+        raise root.error(f"a robot is a tree with one root link; found {len(roots)} ({detail})")
     children: dict[str, list[str]] = {name: [] for name in links}
     for child, (parent, *_rest) in parent_of.items():
         children[parent].append(child)
@@ -292,8 +275,8 @@ def read_urdf(path: str | os.PathLike, *, package_dirs=(), floating_base: bool =
         order.extend(children[name])
     if len(order) != len(links):
         looped = sorted(set(links) - set(order))
-        raise _error(root, f"links {', '.join(map(repr, looped))} are not connected to the root {roots[0]!r}: "
-                           "their joints make a loop")  # fmt: skip
+        raise root.error(f"links {', '.join(map(repr, looped))} are not connected to the root {roots[0]!r}: "
+                         "their joints make a loop")  # fmt: skip
     meshes: dict[str, MeshDescription] = {}
     bodies = []
     for name in order:
