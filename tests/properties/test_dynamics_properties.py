@@ -51,11 +51,12 @@ def test_orientation_stays_unit_and_gravity_changes_momentum_by_m_g_t(integrator
 
 
 @settings(max_examples=25)
-@given(size=extents, quat=unit_quaternions(), omega=vectors3(max_abs=10.0))
-@example(size=(2.0, 0.0625, 0.09375), quat=(0.0, 0.0, 0.0, 1.0), omega=(0.0, 1.0, 6.0))
-def test_symplectic_never_gains_rotational_energy(size, quat, omega):
-    """The implicit gyroscopic step dissipates (Catto 2015): a tumbling body's energy never rises. (The thin box
-    gained 7e-9 of its energy in its first step while the step was one bare Newton iteration.)"""
+@given(size=extents, quat=unit_quaternions(), omega=vectors3(max_abs=10.0), dt=st.sampled_from([1e-3, 1e-2, 0.05]))
+@example(size=(2.0, 0.0625, 0.09375), quat=(0.0, 0.0, 0.0, 1.0), omega=(0.0, 1.0, 6.0), dt=1e-2)
+def test_symplectic_never_gains_rotational_energy(size, quat, omega, dt):
+    """The implicit gyroscopic step dissipates (Catto 2015): a tumbling body's energy never rises, at 1 kHz, 100 Hz
+    and 20 Hz. (The thin box gained 7e-9 of its energy in its first step while the step was one bare Newton
+    iteration.)"""
     world, _ = random_world("symplectic", size, quat, (0, 0, 0), omega)
-    traj = world.simulate(1.0, 1e-2)
+    traj = world.simulate(1.0, dt)
     assert np.all(np.diff(traj.kinetic_energy) <= 1e-12 * traj.kinetic_energy[0] + 1e-300)
