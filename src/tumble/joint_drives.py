@@ -24,7 +24,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from .math3d import quat_mul, quat_to_mat33
-from .rotation import quat_to_matrix
 
 __all__ = ["JointDrive", "JointDrives"]
 
@@ -73,7 +72,7 @@ class JointDrives:
 
     def forces(self, world) -> np.ndarray:
         """Each actuator's force ``f`` along its length now (before its gear)."""
-        return self._forces(world, _spins(world))[0]
+        return self._forces(world, world.angular_velocities())[0]
 
     def _forces(self, world, angular_velocities) -> tuple[np.ndarray, dict]:
         """Each actuator's force, and the coordinates' frames of the universal and ball joints they drive."""
@@ -102,7 +101,7 @@ class JointDrives:
 
     def apply(self, world, t) -> None:
         """Before a step: each actuator's torque (or force) on its two bodies, added to the step's loads at once."""
-        forces, multi = self._forces(world, _spins(world))
+        forces, multi = self._forces(world, world.angular_velocities())
         loads = np.array([d.gear for d in self.drives]) * forces
         state, inputs = world.state, world.inputs
         specs = [world._builder.joints[d.joint.index] for d in self.drives]
@@ -164,15 +163,6 @@ def _angles(world, drive: JointDrive, angular_velocities) -> tuple[np.ndarray, n
         inverse = np.linalg.inv(np.array([frame_a @ basis[:, 0], frame_a @ turned, frame_b @ basis[:, 2]]))
     spin_a = np.zeros(3) if spec.body_a < 0 else angular_velocities[spec.body_a]
     return q, inverse.T @ (angular_velocities[spec.body_b] - spin_a), inverse
-
-
-def _spins(world) -> np.ndarray:
-    """``ω = R I⁻¹ Rᵀ L`` of every body (world frame), as ``World.angular_velocities`` gives it, from one batch of
-    rotation matrices (its two validated quaternion rotations cost 0.43 ms a step for the humanoid, this 0.1)."""
-    model, state = world.model, world.state
-    rotations = quat_to_matrix(state.body_quat)  # (n, 3, 3), one call for every body
-    local = np.einsum("nji,nj->ni", rotations, state.body_angmom)
-    return np.einsum("nij,nj->ni", rotations, np.einsum("nij,nj->ni", model.body_inv_inertia_local, local))
 
 
 def _multiply(a: np.ndarray, b: np.ndarray) -> np.ndarray:
