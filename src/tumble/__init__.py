@@ -13,6 +13,7 @@ from __future__ import annotations
 __version__ = "0.1.0"
 
 from . import actuators, control, mass, rotation, sensors, shapes, vehicles, wind
+from .batch import Batch
 from .errors import SimulationError
 from .handles import Body, Joint
 from .joints import BallJoint, DistanceJoint, FixedJoint, HingeJoint, PlanarJoint, SliderJoint, UniversalJoint
@@ -65,6 +66,7 @@ __all__ = [
     "Articulation",
     "Ball",
     "BallJoint",
+    "Batch",
     "Body",
     "Box",
     "Capsule",
