@@ -5,14 +5,14 @@ copy-major, so that ``body_pos.reshape(copies * bodies, 3)`` is a view of the sa
 ``c``'s ``world.state.body_pos``. The model is the world's, with per-copy overrides (gravity, masses, friction,
 restitution, joint drive targets) packed as ``(copies, ...)`` tables beside it.
 
-A step runs the world's own pipeline (``pipeline.simulate_steps``), not a second engine:
+A step runs the world's own pipeline (``pipeline.simulate_steps``), not a second engine: a block of copies is one
+world whose rows are the copies' rows one copy after the other (``batch_rows.py``), stepped by one call per stage
+for all its copies.
 
-- without contacts or joints the copies are one world of ``copies × bodies`` independent rows, advanced by one call
-  of the free-motion kernel (split over threads by ``dynamics/integrate.py``; rows never interact, so every split
-  gives the same bits). Each copy's gravity is folded into its rows' constant force, ``F + m g``: the sum the
-  kernel forms for one world, so the bits are those of a world with that gravity;
-- with contacts or joints each copy steps through the contact pipeline on views of its rows, blocks of copies on
-  the free-motion kernel's threads (the kernels release the GIL; copies share nothing they write).
+- Free bodies (nothing touches, no joints): one block of every copy; the free-motion kernel splits its rows over
+  threads itself (rows never interact, so every split gives the same bits).
+- Contacts or joints: one block per core, stepped on the free-motion kernel's threads (the kernels release the
+  GIL); the broad phase pairs no shapes of different copies, so a block costs what its copies' bodies cost.
 
 Either way a copy's trajectory is bit for bit the one of a world built with that copy's values.
 """
@@ -21,24 +21,24 @@ from __future__ import annotations
 
 import copy
 import dataclasses
+import os
 from dataclasses import dataclass
 
 import numpy as np
 
 from ._validate import _show, as_array, as_count, as_step, listed
+from .batch_rows import DRIVE_TARGET, copy_impulses, rows_model, splice_contacts, tiled_impulses
 from .dynamics.actuation import ActuatorArrays
 from .dynamics.integrate import _thread_pool, threads
 from .errors import SimulationError
 from .inputs import Inputs
-from .model import Model
 from .pipeline import simulate_steps
 from .scratch import Scratch
 from .state import State
 
 __all__ = ["Batch", "BatchState"]
 
-_FIELDS = ("body_pos", "body_quat", "body_linvel", "body_angmom", "body_sleep_time", "body_sleeping", "body_island")
-_DRIVE_TARGET = 6  # the column of JointArrays.drive that holds a spring drive's target
+_FIELDS = ("body_pos", "body_quat", "body_linvel", "body_angmom", "body_sleep_time", "body_sleeping")
 
 
 @dataclass(frozen=True, eq=False)
@@ -50,7 +50,7 @@ class BatchState:
         body_pos: (copies, bodies, 3) [m] centre of mass, world frame.
         body_quat: (copies, bodies, 4) unit quaternion ``[w, x, y, z]``, body to world.
         body_linvel: (copies, bodies, 3) [m/s]; body_angmom: (copies, bodies, 3) [kg m²/s], about the COM.
-        body_sleep_time: (copies, bodies) [s]; body_sleeping: (copies, bodies) bool; body_island: (copies, bodies).
+        body_sleep_time: (copies, bodies) [s]; body_sleeping: (copies, bodies) bool.
     """
 
     body_pos: np.ndarray
@@ -59,7 +59,6 @@ class BatchState:
     body_angmom: np.ndarray
     body_sleep_time: np.ndarray
     body_sleeping: np.ndarray
-    body_island: np.ndarray
 
     @classmethod
     def tiled(cls, state: State, copies: int) -> BatchState:
@@ -68,13 +67,32 @@ class BatchState:
     def copy(self) -> BatchState:
         return BatchState(**{f: getattr(self, f).copy() for f in _FIELDS})
 
-    def copy_state(self, c: int) -> State:
-        """Copy ``c`` as a :class:`State` whose body arrays are views of row ``c`` (no contacts or joint impulses)."""
-        return State(**{f: getattr(self, f)[c] for f in _FIELDS})
+    def rows(self, first: int, last: int, island: np.ndarray) -> State:
+        """Copies ``first..last-1`` as one state of their rows (views), with the islands ``island``."""
+        return State(**{f: getattr(self, f)[first:last].reshape(-1, *getattr(self, f).shape[2:]) for f in _FIELDS},
+                     body_island=island)  # fmt: skip
 
-    def flat_state(self) -> State:
-        """Every copy as one state of ``copies × bodies`` rows (views)."""
-        return State(**{f: getattr(self, f).reshape(-1, *getattr(self, f).shape[2:]) for f in _FIELDS})
+
+class _Block:
+    """Copies ``first..last-1`` as one world of their rows: a state of views into the batch's arrays with the
+    copies' contacts, joint impulses and islands (numbered in the block), their loads (views), buffers, a model."""
+
+    def __init__(self, batch: Batch, first: int, last: int, template: State) -> None:
+        base, k = batch._base, last - first
+        bodies = base.body_count
+        island = np.tile(template.body_island, k)
+        island = np.where(island >= 0, island + np.repeat(np.arange(k) * bodies, bodies), island)
+        self.first, self.last = first, last
+        self.state = batch._state.rows(first, last, island)
+        tiled_impulses(self.state, template, k, base.shape_count)
+        self.state.time, self.state.step_count = template.time, template.step_count
+        inputs = batch._inputs
+        self.inputs = Inputs(
+            inputs.body_force[first:last].reshape(-1, 3), inputs.body_torque[first:last].reshape(-1, 3)
+        )
+        self.scratch = Scratch.for_world(k * bodies, k * base.shape_count, k * base.joint_count)
+        self.acts = ActuatorArrays.empty(k * bodies)
+        self.model = None
 
 
 def _refuse_unsupported(world) -> None:
@@ -131,28 +149,12 @@ class Batch:
         self._mass = np.tile(base.body_mass, (n, 1))
         self._friction = np.tile(base.shape_friction, (n, 1))
         self._restitution = np.tile(base.shape_restitution, (n, 1))
-        self._drive_target = np.tile(base.joints.drive[:, _DRIVE_TARGET], (n, 1))
-        self._no_actuators = ActuatorArrays.empty(base.body_count if base.has_constraints else n * base.body_count)
-        self._clock = State.empty(0)
-        self._clock.time, self._clock.step_count = state.time, state.step_count
-        self._models: list[Model] | None = None  # per copy (contacts, joints) or one flat model (free bodies)
-        if base.has_constraints:
-            self._copies = [self._fresh_copy(c) for c in range(n)]
-            self._copy_inputs = [Inputs(self._inputs.body_force[c], self._inputs.body_torque[c]) for c in range(n)]
-            self._scratches = [Scratch.for_world(base.body_count, base.shape_count, base.joint_count) for _ in range(n)]
-        else:
-            self._flat = self._state.flat_state()
-            self._flat_inputs = Inputs(self._inputs.body_force.reshape(-1, 3), self._inputs.body_torque.reshape(-1, 3))
-            self._flat_scratch = Scratch.for_world(n * base.body_count, 0)
-
-    def _fresh_copy(self, c: int) -> State:
-        """Copy ``c``'s state over its rows, with the world's contacts and joint impulses to warm-start from."""
-        state = self._state.copy_state(c)
-        for f in ("contact_shape_a", "contact_shape_b", "contact_point_count", "contact_feature",
-                  "contact_normal_impulse", "contact_tangent_impulse", "joint_linear_impulse", "joint_angular_impulse",
-                  "joint_drive_impulse"):  # fmt: skip
-            setattr(state, f, getattr(self._template, f).copy())
-        return state
+        self._drive_target = np.tile(base.joints.drive[:, DRIVE_TARGET], (n, 1))
+        self._stale = True  # the blocks' models are rebuilt before the next step
+        # One block of every copy for free bodies (their kernel threads itself), else one block per core.
+        parts = 1 if not base.has_constraints else min(os.cpu_count() or 1, n)
+        bounds = np.linspace(0, n, parts + 1).astype(np.int64).tolist()
+        self._blocks = [_Block(self, lo, hi, state) for lo, hi in zip(bounds[:-1], bounds[1:], strict=True)]
 
     # --- reading ------------------------------------------------------------------------------------
 
@@ -186,11 +188,11 @@ class Batch:
     @property
     def time(self) -> float:
         """Simulated time [s], the same for every copy."""
-        return self._clock.time
+        return self._blocks[0].state.time
 
     @property
     def step_count(self) -> int:
-        return self._clock.step_count
+        return self._blocks[0].state.step_count
 
     @property
     def gravity(self) -> np.ndarray:
@@ -283,7 +285,7 @@ class Batch:
         for name, value in new.items():
             getattr(self, f"_{name}")[rows] = value
         if new:
-            self._models = None
+            self._stale = True
 
     def _per_copy(self, name: str, value, width: int, rows: int) -> np.ndarray:
         array = as_array(name, value, (width,))
@@ -308,53 +310,28 @@ class Batch:
         if not np.isfinite(largest).all():
             raise ValueError(f"mass={listed(mass)} scales an inertia out of float range")
 
-    def _body_tables(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        """``(mass, inv_mass, inertia, inv_inertia)`` per copy and body: the world's inertia scaled by the copy's mass
-        over the world's (``MassProperties.scaled_to``'s rule), inverted as ``ModelBuilder.finalize`` inverts."""
-        base, mass = self._base, self._mass
+    def _tables(self, first: int, last: int) -> dict[str, np.ndarray]:
+        """Copies ``first..last-1``'s values for :func:`~tumble.batch_rows.rows_model`: masses as given, inertias the
+        world's scaled by the copy's mass over the world's (``MassProperties.scaled_to``'s rule) and inverted as
+        ``ModelBuilder.finalize`` inverts them."""
+        base, mass = self._base, self._mass[first:last]
         dynamic = base.body_is_dynamic
         scale = np.divide(mass, base.body_mass, out=np.ones_like(mass), where=dynamic)
         inertia = base.body_inertia_local * scale[:, :, None, None]
         inv_inertia = np.zeros_like(inertia)
         inv_inertia[:, dynamic] = np.linalg.inv(inertia[:, dynamic])
         inv_mass = np.divide(1.0, mass, out=np.zeros_like(mass), where=dynamic)
-        return mass, inv_mass, inertia, inv_inertia
+        span = slice(first, last)
+        return {"gravity": self._gravity[span], "mass": mass, "inv_mass": inv_mass, "inertia": inertia,
+                "inv_inertia": inv_inertia, "friction": self._friction[span], "restitution": self._restitution[span],
+                "drive_target": self._drive_target[span]}  # fmt: skip
 
-    def _copy_models(self) -> list[Model]:
-        """Each copy's model: the world's with the copy's values (copies without overrides share it)."""
-        base = self._base
-        mass, inv_mass, inertia, inv_inertia = self._body_tables()
-        models = []
-        for c in range(self._n):
-            drive = base.joints.drive.copy()
-            drive[:, _DRIVE_TARGET] = self._drive_target[c]
-            model = dataclasses.replace(
-                base, gravity=self._gravity[c].copy(), body_mass=mass[c], body_inv_mass=inv_mass[c],
-                body_inertia_local=inertia[c], body_inv_inertia_local=inv_inertia[c],
-                shape_friction=self._friction[c].copy(), shape_restitution=self._restitution[c].copy(),
-                joints=base.joints._replace(drive=drive),
-            )  # fmt: skip
-            model.body_arrays, model.body_free_to_sweep  # noqa: B018 (cached here, not raced for by the threads)
-            models.append(model)
-        return models
-
-    def _flat_model(self) -> Model:
-        """Every copy's bodies as the rows of one model without gravity, each copy's weight in its constant force."""
-        base, n = self._base, self._n
-        mass, inv_mass, inertia, inv_inertia = self._body_tables()
-        weight = base.body_constant_force + self._gravity[:, None, :] * mass[:, :, None]
-
-        def tiled(array):
-            return np.tile(array, (n,) + (1,) * (array.ndim - 1))
-
-        return dataclasses.replace(
-            base, gravity=np.zeros(3), body_mass=mass.reshape(-1), body_inv_mass=inv_mass.reshape(-1),
-            body_inertia_local=inertia.reshape(-1, 3, 3), body_inv_inertia_local=inv_inertia.reshape(-1, 3, 3),
-            body_com_local=tiled(base.body_com_local), body_is_dynamic=tiled(base.body_is_dynamic),
-            body_linear_damping=tiled(base.body_linear_damping), body_angular_damping=tiled(base.body_angular_damping),
-            body_name=base.body_name * n, body_constant_force=weight.reshape(-1, 3),
-            body_constant_torque=tiled(base.body_constant_torque),
-        )  # fmt: skip
+    def _block_of(self, c: int) -> tuple[_Block, int]:
+        """The block holding copy ``c`` and the copy's place in it."""
+        for block in self._blocks:
+            if block.first <= c < block.last:
+                return block, c - block.first
+        raise AssertionError(c)
 
     # --- loads --------------------------------------------------------------------------------------
 
@@ -400,57 +377,56 @@ class Batch:
         """
         dt = as_step("dt", dt, self.time)
         steps = as_count("steps", steps)
-        if self._base.has_constraints:
+        free = not self._base.has_constraints
+        if not free:
             self._params.solver.substeps_for(dt)
-        if self._models is None:
-            self._models = self._copy_models() if self._base.has_constraints else [self._flat_model()]
-        if self._base.has_constraints:
-            failure = self._step_copies(dt, steps)
-        else:
-            self._flat.time, self._flat.step_count = self._clock.time, self._clock.step_count
-            done, row = simulate_steps(self._models[0], self._flat, self._flat_inputs, self._params,
-                                       self._flat_scratch, dt, steps, acts=self._no_actuators)  # fmt: skip
-            self._clock.time, self._clock.step_count = self._flat.time, self._flat.step_count
+        if self._stale:
+            for block in self._blocks:
+                block.model = rows_model(self._base, self._tables(block.first, block.last), fold_gravity=free)
+            self._stale = False
+        if free:  # one call for every step: the kernel keeps the last step all rows completed
+            block = self._blocks[0]
+            _, row = simulate_steps(block.model, block.state, block.inputs, self._params, block.scratch, dt, steps,
+                                    acts=block.acts)  # fmt: skip
             failure = None if row < 0 else divmod(row, self.body_count)
+        else:
+            failure = self._step_blocks(dt, steps)
         if failure is not None:
             raise self._failed(*failure)
 
-    def _step_copies(self, dt: float, steps: int) -> tuple[int, int] | None:
-        """Contacts and joints: each step, every copy through the pipeline; blocks of copies on the threads."""
-        count = min(threads(), self._n)
-        bounds = np.linspace(0, self._n, count + 1).astype(np.int64)
-        blocks = list(zip(bounds[:-1].tolist(), bounds[1:].tolist(), strict=True))
+    def _step_blocks(self, dt: float, steps: int) -> tuple[int, int] | None:
+        """Contacts and joints: step by step, every block on the threads; a failure in one block takes every block
+        back to the state before that step."""
+        blocks = self._blocks
+        workers = min(threads(), len(blocks))
         for _ in range(steps):
-            before = [state.copy() for state in self._copies]
-            if count > 1:
+            before = [block.state.copy() for block in blocks] if len(blocks) > 1 else None
+            if workers > 1:
                 errors = np.geterr()  # NumPy's error settings are per thread: the caller's hold in the workers too
-                futures = [_thread_pool().submit(self._step_block, lo, hi, dt, errors) for lo, hi in blocks]
-                results = [future.result() for future in futures]
+                futures = [_thread_pool().submit(self._step_block, block, dt, errors) for block in blocks]
+                rows = [future.result() for future in futures]
             else:
-                results = [self._step_block(0, self._n, dt)]
-            failed = [r for r in results if r is not None]
+                rows = [self._step_block(block, dt) for block in blocks]
+            failed = [(block, row) for block, row in zip(blocks, rows, strict=True) if row >= 0]
             if failed:
-                for state, old in zip(self._copies, before, strict=True):
-                    state.assign(old)
+                if before is not None:
+                    for block, old in zip(blocks, before, strict=True):
+                        block.state.assign(old)
                 self._inputs.body_force.fill(0.0)
                 self._inputs.body_torque.fill(0.0)
-                return failed[0]
-            self._clock.time, self._clock.step_count = self._copies[0].time, self._copies[0].step_count
+                block, row = failed[0]
+                copy_in_block, body = divmod(row, self.body_count)
+                return block.first + copy_in_block, body
         return None
 
-    def _step_block(self, first: int, last: int, dt: float, errors: dict | None = None) -> tuple[int, int] | None:
-        """One step of copies ``first..last-1`` (under NumPy's error settings ``errors``, if given): ``(copy, body)``
-        of the first that failed, or None."""
+    def _step_block(self, block: _Block, dt: float, errors: dict | None = None) -> int:
+        """One step of a block (under NumPy's error settings ``errors``, if given): the failing row, or -1."""
         if errors is not None:
             with np.errstate(**errors):
-                return self._step_block(first, last, dt)
-        failure = None
-        for c in range(first, last):
-            _, body = simulate_steps(self._models[c], self._copies[c], self._copy_inputs[c], self._params,
-                                     self._scratches[c], dt, 1, acts=self._no_actuators)  # fmt: skip
-            if body >= 0 and failure is None:
-                failure = (c, body)
-        return failure
+                return self._step_block(block, dt)
+        _, row = simulate_steps(block.model, block.state, block.inputs, self._params, block.scratch, dt, 1,
+                                acts=block.acts)  # fmt: skip
+        return row
 
     def _failed(self, c: int, body: int) -> SimulationError:
         name = self._base.body_name[body]
@@ -494,19 +470,24 @@ class Batch:
         if given:  # a new state: awake, with nothing to warm-start from
             self._state.body_sleep_time[rows] = 0.0
             self._state.body_sleeping[rows] = False
-            self._state.body_island[rows] = -1
         self._inputs.body_force[rows] = 0.0
         self._inputs.body_torque[rows] = 0.0
-        if self._base.has_constraints:
-            for c in rows.tolist():
-                fresh = self._fresh_copy(c)
-                if given:
-                    fresh.forget_contacts()
-                    for f in ("joint_linear_impulse", "joint_angular_impulse", "joint_drive_impulse"):
-                        getattr(fresh, f).fill(0.0)
-                fresh.time, fresh.step_count = self.time, self.step_count
-                self._copies[c] = fresh
-                self._scratches[c].contact_count = 0
+        for block in self._blocks:
+            mine = rows[(rows >= block.first) & (rows < block.last)] - block.first
+            if mine.size:
+                self._restart(block, mine, None if given else self._template)
+
+    def _restart(self, block: _Block, copies: np.ndarray, template: State | None) -> None:
+        """The islands, contacts and joint impulses of a block's local ``copies``: the template's, or none."""
+        base, state = self._base, block.state
+        bodies, joints = base.body_count, base.joint_count
+        for j in copies.tolist():
+            island = np.full(bodies, -1, np.int64) if template is None else template.body_island
+            state.body_island[j * bodies : (j + 1) * bodies] = np.where(island >= 0, island + j * bodies, -1)
+            for name in ("joint_linear_impulse", "joint_angular_impulse", "joint_drive_impulse"):
+                rows = getattr(state, name)[j * joints : (j + 1) * joints]
+                rows[:] = 0.0 if template is None else getattr(template, name)
+        splice_contacts(state, copies, template, base.shape_count)
 
     def _per_copy_rows(self, name: str, value, width: int, rows: int) -> np.ndarray:
         array = as_array(name, value, (self.body_count, width))
@@ -540,8 +521,13 @@ class Batch:
                 k += 1
         for j, spec in enumerate(builder.joints):
             spec.drive = spec.drive.copy()
-            spec.drive[_DRIVE_TARGET] = self._drive_target[c, j]
-        state = self._copies[c].copy() if base.has_constraints else self._state.copy_state(c).copy()
+            spec.drive[DRIVE_TARGET] = self._drive_target[c, j]
+        block, j = self._block_of(c)
+        bodies = base.body_count
+        island = block.state.body_island[j * bodies : (j + 1) * bodies]
+        state = State(**{f: getattr(self._state, f)[c].copy() for f in _FIELDS},
+                      body_island=np.where(island >= 0, island - j * bodies, -1),
+                      **copy_impulses(block.state, j, base.shape_count, base.joint_count))  # fmt: skip
         state.time, state.step_count = self.time, self.step_count
         inputs = Inputs(self._inputs.body_force[c].copy(), self._inputs.body_torque[c].copy())
         return World._from_builder(builder, state, inputs, gravity=self._gravity[c].copy(),

@@ -59,6 +59,10 @@ class Model:
             frame; the force at the centre of mass), set with ``Body.constant_force`` and ``constant_torque``.
         joints: the world joints (:class:`~tumble.dynamics.joint_solver.JointArrays`; body -1 is the world).
         joint_exclusions: (k, 2) int64 sorted body pairs that a joint keeps from colliding.
+        body_gravity: (body_count, 3) [m/s²] the gravity each body falls under with contacts or joints: ``gravity`` in
+            every row (the default), or each copy's for the rows of a batch (``tumble.batch``).
+        copy_shape_count: shapes per copy when the rows are a batch's copies one after the other (shapes of different
+            copies never pair); 0 for a world.
     """
 
     gravity: np.ndarray
@@ -84,6 +88,13 @@ class Model:
     body_constant_torque: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
     joints: JointArrays = field(default_factory=JointArrays.empty)
     joint_exclusions: np.ndarray = field(default_factory=lambda: np.zeros((0, 2), np.int64))
+    body_gravity: np.ndarray | None = None
+    copy_shape_count: int = 0
+
+    def __post_init__(self) -> None:
+        if self.body_gravity is None:  # a world: one gravity for every body
+            rows = np.tile(np.asarray(self.gravity, np.float64), (self.body_count, 1))
+            object.__setattr__(self, "body_gravity", rows)
 
     @property
     def body_count(self) -> int:

@@ -187,6 +187,7 @@ def contact_step(
         excluded_body_pairs=model.joint_exclusions,
         margin=settings.speculative_distance,
         buffer=scratch.pairs,
+        segment_size=model.copy_shape_count,
     )
     # Narrow phase: manifolds, and the impulses of the same points last step.
     scratch.reserve_contacts(pairs_a.shape[0])
@@ -261,7 +262,7 @@ def contact_step(
         bodies,
         moving,
         inv_mass,
-        model.gravity,
+        model.body_gravity,
         inputs.body_force,
         inputs.body_torque,
         acts,

@@ -190,6 +190,22 @@ def test_sweep_equals_brute_force_on_random_scenes(seed):
         assert len(sweep) > 20  # the scene is busy enough to mean something
 
 
+@pytest.mark.parametrize("seed", [0, 1])
+def test_segments_pair_only_within_themselves_as_each_copy_alone(seed):
+    """A batch's copies, laid one after the other in the same place: each pairs as it would alone, never across."""
+    one = random_scene(np.random.default_rng(seed), 60, spread=5.0)
+    copies, shapes, bodies = 3, len(one.shapes), len(one.body_pos)
+    specs = [(shape, int(one.geom.shape_body[s]) + c * bodies, np.zeros(3), IDENTITY)
+             for c in range(copies) for s, shape in enumerate(one.shapes)]  # fmt: skip
+    many = Scene(specs, np.tile(one.body_pos, (copies, 1)), np.tile(one.body_quat, (copies, 1)),
+                 np.tile(one.body_is_dynamic, copies), np.tile(one.body_linvel, (copies, 1)))  # fmt: skip
+    alone = Scene(specs[:shapes], one.body_pos, one.body_quat, one.body_is_dynamic, one.body_linvel)
+    expected = [(a + c * shapes, b + c * shapes) for c in range(copies) for a, b in alone.pairs(0.02, 1 / 60)]
+    assert many.pairs(0.02, 1 / 60, segment_size=shapes) == expected
+    assert len(expected) > 3 * 20
+    assert len(many.pairs(0.02, 1 / 60)) > len(expected)  # without segments the copies would pair
+
+
 def test_sweep_equals_brute_force_on_a_column_and_on_a_pile():
     """Every box in one column overlaps all the others on the sweep axis unless the axis is chosen well."""
     column = Scene(

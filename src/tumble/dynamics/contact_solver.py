@@ -410,11 +410,12 @@ def solve_contacts(
 
 @inline
 def _load_acceleration(i, inv_mass, gravity, force, constant_force):
-    """Body ``i``'s acceleration from gravity and its applied and constant forces (zero if it does not move)."""
+    """Body ``i``'s acceleration from its gravity (row ``i`` of ``gravity``) and its applied and constant forces (zero
+    if it does not move)."""
     if inv_mass[i] == 0.0:
         return (0.0, 0.0, 0.0)
     applied = add(load3(force, i), load3(constant_force, i))
-    return add_scaled((gravity[0], gravity[1], gravity[2]), applied, inv_mass[i])
+    return add_scaled(load3(gravity, i), applied, inv_mass[i])
 
 
 @inline

@@ -59,8 +59,9 @@ def to_angular_momentum(bodies, quat, angvel, angmom):
 
 @inline
 def integrate_velocities(bodies, moving, gravity, force, torque, acts, tau, quat, linvel, angvel, h):
-    """``v += h (g + F/m)``, implicit gyroscopic spin update, implicit damping; moving (awake dynamic) bodies. The
-    actuators' and drag's loads are those of the substep's start state, ``tau`` into the step."""
+    """``v += h (g + F/m)`` (``gravity``: (bodies, 3), each body's ``g``), implicit gyroscopic spin update, implicit
+    damping; moving (awake dynamic) bodies. The actuators' and drag's loads are those of the substep's start state,
+    ``tau`` into the step."""
     for i in range(quat.shape[0]):
         if not moving[i]:
             continue
@@ -70,7 +71,7 @@ def integrate_velocities(bodies, moving, gravity, force, torque, acts, tau, quat
         if acts.driven[i]:
             driven_force, driven_torque = actuator_wrench(acts, i, tau, q, load3(linvel, i), load3(angvel, i))
             applied, spin = add(applied, driven_force), add(spin, driven_torque)
-        accel = add_scaled((gravity[0], gravity[1], gravity[2]), applied, bodies.inv_mass[i])
+        accel = add_scaled(load3(gravity, i), applied, bodies.inv_mass[i])
         v = scale(add_scaled(load3(linvel, i), accel, h), 1.0 / (1.0 + h * bodies.linear_damping[i]))
         store3(linvel, i, v)
         w_body = quat_rotate_inv(q, load3(angvel, i))
