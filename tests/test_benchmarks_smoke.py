@@ -290,3 +290,16 @@ def test_first_run_rows_with_warm_caches():
     rows = first_run.bench_first_run(run.Sizes(**{**run.QUICK.__dict__, "cold_start": False}))
     _assert_finite_numbers(rows)
     assert [r["case"] for r in rows] == ["sphere on a plane"] and rows[0]["run_s"] > 0
+
+
+def test_batch_rows_for_both_scenes_with_ratios_to_mujoco():
+    from benchmarks import batch
+
+    rows = batch.bench_batch(batch.QUICK)
+    _assert_finite_numbers(rows)
+    tumble_rows = [r for r in rows if r["engine"] == "tumble"]
+    assert {r["scene"] for r in tumble_rows} == {"tumbling", "pile"}
+    assert all(r["body_steps_per_s"] > 0 and r["copies"] == (8 if r["scene"] == "tumbling" else 4) for r in tumble_rows)
+    if any(r["engine"] == "MuJoCo" for r in rows):
+        assert all("x_mujoco_Euler_steps" in r for r in tumble_rows if r["scene"] == "tumbling")
+        assert all("x_mujoco_240hz_sim_time" in r for r in tumble_rows if r["scene"] == "pile")

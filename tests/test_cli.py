@@ -441,3 +441,24 @@ def test_warmup_runs_the_scenes_with_kernels_of_their_own_alone_first_and_deals_
     assert len(rest) == 2 and abs(len(rest[0]) - len(rest[1])) <= 1
     assert sorted(p for b in batches for p in b) == sorted(scenes)
     assert warmup._batches(scenes[:1], 4) == [scenes[:1]]
+
+
+# --- tumble batch ---------------------------------------------------------------------------------------------
+
+
+def test_batch_steps_copies_of_a_scene_and_reports_body_steps_per_second(folder):
+    result = tumble_cli("batch", folder / "small.toml", "-n", "16", "--duration", "0.5", "--quiet")
+    assert result.returncode == 0, result.stderr
+    assert "16 copies, done" in result.stdout and "body-steps/s" in result.stdout
+    assert re.search(r"steps\s+.\s+30\s", result.stdout), result.stdout  # 0.5 s at the scene's 60 Hz
+    assert re.search(r"3 dynamic bodies each", result.stdout), result.stdout
+
+
+def test_batch_refuses_what_it_cannot_step_and_names_it(folder):
+    assert_clean_failure(tumble_cli("batch", folder / "small.toml", "-n", "0"), 2, "-n", "0")
+    assert_clean_failure(tumble_cli("batch", folder / "small.toml"), 2, "-n")
+    assert_clean_failure(tumble_cli("batch", "quadrotor_landing", "-n", "2"), 2, "quadrotor_landing",
+                         "a Batch steps bodies, shapes and joints")  # fmt: skip
+    result = tumble_cli("batch", folder / "spinner.toml", "-n", "3", "--quiet")
+    assert_clean_failure(result, 1, "simulation failed", "copy 0: body 'spinner'", "step 25")
+    assert "FAILED" in result.stdout

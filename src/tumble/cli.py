@@ -5,6 +5,7 @@
     tumble run SCENE [--duration S] [--dt S] [--every N] [--out FILE.h5|FILE.npz] [--html FILE] [--plot FILE]
                      [--max-frames N] [--quiet]
     tumble info SCENE
+    tumble batch SCENE -n N [--duration S] [--dt S] [--quiet]
     tumble view TRAJ -o replay.html [--scene SCENE] [--title TEXT] [--max-frames N]
     tumble plot TRAJ [--what energy,momentum,omega,paths] [-o DIR|FILE] [--bodies NAMES]
     tumble examples [--copy DIR] [--force]
@@ -27,25 +28,35 @@ import json
 import math
 import os
 import shutil
-import signal
 import sys
 import tempfile
 import time
 import warnings
-import weakref
 from pathlib import Path
 
-from numba.core import event as numba_event  # numba is loaded with tumble anyway
-
-from ._validate import MAX_COUNT, MAX_STEPS
+from ._validate import MAX_STEPS
+from .cli_common import (
+    EXIT_BAD_INPUT,
+    EXIT_INTERRUPTED,
+    EXIT_OK,
+    EXIT_SIMULATION,
+    EXIT_TERMINATED,
+    BadInput,
+    _consoles,
+    _error,
+    _InterruptLatch,
+    _load_scene,
+    _note,
+    _PipeClosed,
+    _positive_float,
+    _positive_int,
+    _Progress,
+    _shipped_scenes,
+    _Terminated,
+    _text,
+)
 
 __all__ = ["main", "EXIT_OK", "EXIT_SIMULATION", "EXIT_BAD_INPUT", "EXIT_INTERRUPTED", "EXIT_TERMINATED"]
-
-EXIT_OK = 0
-EXIT_SIMULATION = 1
-EXIT_BAD_INPUT = 2
-EXIT_INTERRUPTED = 130
-EXIT_TERMINATED = 143  # 128 + SIGTERM (15), as a shell reports a process that a signal ended
 
 TRAJECTORY_SUFFIXES = (".h5", ".hdf5", ".he5", ".npz")
 PLOT_KINDS = ("energy", "momentum", "omega", "paths", "flight")
@@ -56,44 +67,7 @@ _MIN_CHUNK_FRAMES = 16  # a chunk costs a compiled call and a write: fewer frame
 _TINY = sys.float_info.min  # the smallest normal float64: the floor of |E_0| in the energy drift
 
 
-class BadInput(Exception):
-    """Input the command cannot use: printed as one line, exit status 2."""
-
-
 # --- small helpers ----------------------------------------------------------------------------------------------
-
-
-def _error(message: str) -> None:
-    for line in str(message).splitlines() or [""]:
-        print(f"tumble: error: {line}", file=sys.stderr)
-
-
-def _note(message: str) -> None:
-    print(f"tumble: {message}", file=sys.stderr)
-
-
-class _PipeClosed(Exception):
-    """The reader of stdout went away (``tumble info big.toml | head``): stop quietly."""
-
-
-def _consoles():
-    """(stdout console, stderr console). Off a terminal the width is fixed (no wrapping at 80 columns)."""
-    from rich.console import Console
-
-    class _Console(Console):
-        def on_broken_pipe(self) -> None:  # rich's own exits with status 1, which here means a simulation error
-            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
-            raise _PipeClosed
-
-    width = None if sys.stdout.isatty() or "COLUMNS" in os.environ else 160
-    return _Console(width=width, highlight=False), _Console(stderr=True, highlight=False)
-
-
-def _text(value) -> object:
-    """Plain text for a table cell (no rich markup: names like ``box[3]`` stay as written)."""
-    from rich.text import Text
-
-    return Text(str(value))
 
 
 def _fmt(x: float, digits: int = 4) -> str:
@@ -102,26 +76,6 @@ def _fmt(x: float, digits: int = 4) -> str:
 
 def _vec(values, digits: int = 4) -> str:
     return "(" + ", ".join(_fmt(float(v), digits) for v in values) + ")"
-
-
-def _positive_float(text: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"must be a number, got {text!r}") from None
-    if not (math.isfinite(value) and value > 0.0):
-        raise argparse.ArgumentTypeError(f"must be a finite number > 0, got {text!r}")
-    return value
-
-
-def _positive_int(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"must be an integer, got {text!r}") from None
-    if not 1 <= value <= MAX_COUNT:
-        raise argparse.ArgumentTypeError(f"must be an integer from 1 to {MAX_COUNT}, got {text!r}")
-    return value
 
 
 def _frames_limit(text: str) -> int:
@@ -138,41 +92,6 @@ def _existing_file(path: str, what: str) -> Path:
     if not p.is_file():
         raise BadInput(f"{path}: not a file")
     return p
-
-
-def _scene_path(text: str) -> Path:
-    """The scene file ``text`` names: a path, or the name of a shipped scene (``flagship``)."""
-    path = Path(text)
-    if path.exists():
-        if not path.is_file():
-            raise BadInput(f"{text}: not a file")
-        return path
-    if not path.suffix and len(path.parts) == 1:
-        for shipped in _shipped_scenes():
-            if shipped.stem == text:
-                return shipped
-    raise BadInput(f"{text}: no such scene file (nor a shipped scene; tumble examples lists them)")
-
-
-def _load_scene(text: str):
-    """``(path, loaded scene)``; a SceneError or a missing file becomes :class:`BadInput`."""
-    from . import scene_file
-
-    path = _scene_path(text)
-    try:
-        with warnings.catch_warnings(record=True) as heard:
-            warnings.simplefilter("always")
-            loaded = scene_file.load(path)
-    except scene_file.SceneError as error:
-        raise BadInput(str(error)) from None
-    from .models.mjcf import MJCFWarning
-
-    for message in dict.fromkeys(str(w.message) for w in heard if issubclass(w.category, MJCFWarning)):
-        _note(message)  # a model file's: what tumble does not simulate
-    for w in heard:
-        if not issubclass(w.category, MJCFWarning):
-            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
-    return path, loaded
 
 
 def _load_trajectory(path: str):
@@ -232,116 +151,6 @@ def _prepare_output(path: Path) -> Path:
 
 
 # --- tumble run -------------------------------------------------------------------------------------------------
-
-
-SIMULATING = "simulating"
-COMPILING = "compiling kernels (first run only)…"
-
-
-class _Progress:
-    """A rich progress bar fed by ``recording.record``'s callback; it also times the chunks, so that the steps/s
-    of the summary leave out the first chunk (which pays for loading the compiled kernels).
-
-    On a first run the first chunk waits while Numba compiles the kernels (a minute or more on a fresh machine):
-    the bar's label then says so, with the count of functions compiled, from Numba's ``numba:compile`` events."""
-
-    def __init__(self, console, total_steps: int, start_step: int, duration: float, enabled: bool) -> None:
-        self.start_step = start_step
-        self.first_chunk: tuple[float, int] | None = None  # (time.perf_counter(), steps) after the first chunk
-        self.last: tuple[float, int] | None = None
-        self.compiled = 0  # functions Numba compiled while the bar was up
-        self._bar = None
-        self._watch = None
-        if enabled:
-            from rich.progress import BarColumn, Progress, TaskProgressColumn, TextColumn, TimeRemainingColumn
-
-            self._bar = Progress(
-                TextColumn("{task.fields[stage]}"),
-                BarColumn(),
-                TaskProgressColumn(),
-                TextColumn("t = {task.fields[t]:.3g} / {task.fields[duration]:.3g} s"),
-                TimeRemainingColumn(),
-                console=console,
-                transient=True,
-            )
-            self._task = self._bar.add_task("run", total=total_steps, t=0.0, duration=duration, stage=SIMULATING)
-            self._watch = _CompileWatch(self._compiled)
-
-    def __enter__(self):
-        if self._bar is not None:
-            numba_event.register("numba:compile", self._watch)
-            self._bar.start()
-        return self
-
-    def __exit__(self, *exc) -> None:
-        if self._bar is not None:
-            numba_event.unregister("numba:compile", self._watch)
-            self._bar.stop()
-
-    def _compiled(self) -> None:
-        self.compiled += 1
-        if self.first_chunk is None:
-            self._bar.update(self._task, stage=f"{COMPILING} {self.compiled} functions")
-
-    def __call__(self, world, writer) -> None:
-        now, steps = time.perf_counter(), world.step_count - self.start_step
-        if self.first_chunk is None:
-            self.first_chunk = (now, steps)
-        self.last = (now, steps)
-        if self._bar is not None:
-            self._bar.update(self._task, completed=steps, t=world.time, stage=SIMULATING)
-
-
-class _CompileWatch(numba_event.Listener):
-    """Calls ``on_compile()`` at the end of each Numba compilation (not for a load from the cache)."""
-
-    def __init__(self, on_compile) -> None:
-        self._on_compile = on_compile
-
-    def on_start(self, event) -> None:
-        pass
-
-    def on_end(self, event) -> None:
-        self._on_compile()
-
-
-class _Terminated(KeyboardInterrupt):
-    """SIGTERM (``kill``, a job scheduler's end of time), raised where Ctrl-C would be, so that it stops a run the
-    same way: the recording closed with status 'interrupted', a message, and :data:`EXIT_TERMINATED`."""
-
-
-def _stop_signals() -> list[int]:
-    return [getattr(signal, name) for name in ("SIGINT", "SIGTERM") if hasattr(signal, name)]
-
-
-class _InterruptLatch:
-    """Ctrl-C and SIGTERM that cannot be lost. Python raises ``KeyboardInterrupt`` wherever the main thread is, and
-    drops it, with a traceback on stderr, when that is a weakref callback or a ``__del__`` ("Exception ignored in
-    ..."): the run then went on. The latch raises it at once unless it landed in one of those, and remembers it, so
-    that the next chunk's callback raises it in any case. SIGTERM raises :class:`_Terminated`, a KeyboardInterrupt."""
-
-    def __init__(self) -> None:
-        self.requested: int | None = None  # the signal received
-        self._previous: dict[int, object] = {}
-
-    def __enter__(self):
-        for number in _stop_signals():
-            self._previous[number] = signal.signal(number, self._handle)
-        return self
-
-    def __exit__(self, *exc) -> None:
-        for number, previous in self._previous.items():
-            signal.signal(number, previous)
-
-    def _handle(self, signum, frame) -> None:
-        self.requested = signum
-        if frame is not None and (frame.f_code.co_name == "__del__" or frame.f_code.co_filename == weakref.__file__):
-            return  # Python would drop it here: the next chunk raises it
-        self.check()
-
-    def check(self) -> None:
-        if self.requested is not None:
-            raise _Terminated if self.requested == getattr(signal, "SIGTERM", None) else KeyboardInterrupt
 
 
 def _chunk_frames(body_count: int, frames: int, hdf5: bool) -> int:
@@ -747,12 +556,6 @@ def _mesh_files(data) -> list[str]:
     return found
 
 
-def _shipped_scenes() -> list[Path]:
-    from . import scene_file
-
-    return list(scene_file.shipped())
-
-
 def _cmd_warmup(args) -> int:
     from .warmup import default_jobs, warmup
 
@@ -902,6 +705,10 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--max-frames", type=_frames_limit, metavar="N", help="keep at most N frames in the replay")
     run.add_argument("--quiet", "-q", action="store_true", help="no progress bar")
     run.set_defaults(handler=_cmd_run)
+
+    from .cli_batch import add_command as add_batch_command
+
+    add_batch_command(commands, _positive_int, _positive_float)
 
     info = commands.add_parser("info", help="the bodies, joints and settings of a scene file",
                                description="Load a scene file and print its bodies (mass, centre of mass, principal "

@@ -168,16 +168,15 @@ def _emit(shape_type, a, b, out_a, out_b, count):
 
 @kernel
 def _sweep_kernel(
-    order, segment, sorted_lo, sorted_hi, shape_type, shape_body, body_is_dynamic, shape_group, shape_mask, excluded,
-    out_a, out_b, count,
+    order, segment_size, sorted_lo, sorted_hi, shape_type, shape_body, body_is_dynamic, shape_group, shape_mask,
+    excluded, out_a, out_b, count,
 ):  # fmt: skip
     """Sort-and-sweep; returns the new pair count.
 
-    ``order`` lists the finite boxes by segment, then by increasing lower bound on the sweep axis; ``segment`` is
-    their segment in that order (boxes of different segments never pair); ``sorted_lo``, ``sorted_hi`` ((n, 3)
-    float64) are their bounds in that order, with the sweep axis moved to column 0 so the inner loop reads memory
-    in sequence. Writes at most ``len(out_a)`` pairs but counts all of them, so the caller can grow the buffers and
-    rerun.
+    ``order`` lists the finite boxes by segment (shape row // ``segment_size``, when > 0: boxes of different segments
+    never pair), then by increasing lower bound on the sweep axis; ``sorted_lo``, ``sorted_hi`` ((n, 3) float64) are
+    their bounds in that order, with the sweep axis moved to column 0 so the inner loop reads memory in sequence.
+    Writes at most ``len(out_a)`` pairs but counts all of them, so the caller can grow the buffers and rerun.
     """
     n = order.shape[0]
     for i in range(n):
@@ -186,7 +185,7 @@ def _sweep_kernel(
         for j in range(i + 1, n):
             # Sorted by lower bound: every later box starts after this one ends. Before that, the boxes overlap
             # on the sweep axis (lo_i <= lo_j <= hi_j); test the other two, closed intervals as the brute force.
-            if sorted_lo[j, 0] > end or segment[j] != segment[i]:
+            if sorted_lo[j, 0] > end or (segment_size > 0 and order[j] // segment_size != order[i] // segment_size):
                 break
             if sorted_lo[j, 1] > hi_1 or lo_1 > sorted_hi[j, 1] or sorted_lo[j, 2] > hi_2 or lo_2 > sorted_hi[j, 2]:
                 continue
@@ -198,11 +197,12 @@ def _sweep_kernel(
 
 @kernel
 def _plane_kernel(
-    planes, boxes, box_start, box_end, geom, body_pos, body_quat, aabb_lo, aabb_hi, body_is_dynamic, shape_group,
-    shape_mask, excluded, margin, out_a, out_b, count,
+    planes, boxes, segment_size, geom, body_pos, body_quat, aabb_lo, aabb_hi, body_is_dynamic, shape_group, shape_mask,
+    excluded, margin, out_a, out_b, count,
 ):  # fmt: skip
-    """Pair each plane ``planes[i]`` with every box of ``boxes[box_start[i]:box_end[i]]`` (those of its segment) whose
-    lowest corner along the plane normal is within ``margin`` of it.
+    """Pair each plane with every box of its segment (``boxes``, ascending, whose row // ``segment_size`` is the
+    plane's; every box when ``segment_size`` is 0) whose lowest corner along the plane normal is within ``margin``
+    of it.
 
     The plane ``n · x = d`` of shape frame ``(p, q)`` is ``(R n) · x = d + (R n) · p`` in the world. The box
     ``[lo, hi]`` reaches ``min n · x = Σ_k n_k (lo_k if n_k >= 0 else hi_k)``: its support point along ``-n``.
@@ -218,7 +218,11 @@ def _plane_kernel(
         params = math3d.load4(geom.shape_params, p)
         normal = math3d.quat_rotate(q_plane, (params[0], params[1], params[2]))
         offset = params[3] + math3d.dot(normal, origin)
-        for j in range(box_start[i], box_end[i]):
+        first, last = 0, boxes.shape[0]
+        if segment_size > 0:
+            start = p // segment_size * segment_size
+            first, last = np.searchsorted(boxes, start), np.searchsorted(boxes, start + segment_size)
+        for j in range(first, last):
             s = boxes[j]
             lowest = 0.0
             for k in range(3):
@@ -350,13 +354,10 @@ def find_pairs(
     if boxes.shape[0] > 1:
         centers = aabb_lo[boxes] + aabb_hi[boxes]
         axis = int(np.argmax(centers.var(axis=0)))
-    # Boxes by segment, then along the axis; each plane meets the boxes of its own segment only.
-    segment = boxes // segment_size if segment_size > 0 else np.zeros(boxes.shape[0], np.int64)
-    plane_segment = planes // segment_size if segment_size > 0 else np.zeros(planes.shape[0], np.int64)
-    by_segment = np.lexsort((aabb_lo[boxes, axis], segment))
-    order, order_segment = boxes[by_segment], segment[by_segment]
-    box_start = np.searchsorted(segment, plane_segment, side="left")
-    box_end = np.searchsorted(segment, plane_segment, side="right")
+    if segment_size > 0:  # by segment, then along the axis
+        order = boxes[np.lexsort((aabb_lo[boxes, axis], boxes // segment_size))]
+    else:
+        order = boxes[np.argsort(aabb_lo[boxes, axis], kind="stable")]
     columns = [axis, (axis + 1) % 3, (axis + 2) % 3]
     sorted_lo = np.ascontiguousarray(aabb_lo[order][:, columns])
     sorted_hi = np.ascontiguousarray(aabb_hi[order][:, columns])
@@ -364,11 +365,11 @@ def find_pairs(
         buffer = PairBuffer(max(64, 2 * shape_count))
     while True:
         count = _sweep_kernel(
-            order, order_segment, sorted_lo, sorted_hi, geom.shape_type, geom.shape_body, body_is_dynamic, group, mask,
-            excluded, buffer.a, buffer.b, 0,
+            order, int(segment_size), sorted_lo, sorted_hi, geom.shape_type, geom.shape_body, body_is_dynamic, group,
+            mask, excluded, buffer.a, buffer.b, 0,
         )  # fmt: skip
         count = _plane_kernel(
-            planes, boxes, box_start, box_end, geom, body_pos, body_quat, aabb_lo, aabb_hi, body_is_dynamic, group,
+            planes, boxes, int(segment_size), geom, body_pos, body_quat, aabb_lo, aabb_hi, body_is_dynamic, group,
             mask, excluded, float(margin), buffer.a, buffer.b, count,
         )  # fmt: skip
         if count <= buffer.capacity:

@@ -1,0 +1,198 @@
+"""Many copies at once: ``tumble.Batch`` against ``mujoco.rollout`` with the same copies and threads (issue 28).
+
+Run from the repository root:
+
+    python -m benchmarks.batch [--quick] [--repeat N]
+    python -m benchmarks.run --only batch
+
+``tumbling``  4096 copies of one free body (I = diag(1, 2, 3) kg m², ω₀ = (0.01, 5, 0.01) rad/s, no gravity),
+              1000 steps of 1 ms: tumble's default integrator (RK4 for this anisotropic body) in one
+              ``batch.step(dt, steps)`` call, MuJoCo's RK4 and Euler in one rollout call.
+``pile``      1024 copies of a pile of 10 cubes of 0.2 m (``scenes.box_pile(10)``) dropped on a plane, 1 s: tumble
+              at 60 Hz (its default, 8 substeps), MuJoCo at 60 Hz (the same step) and 240 Hz (the contact
+              benchmarks' rate, where its default soft contacts hold a pile), Newton solver.
+
+Each engine runs on 1 and 2 threads (``tumble.dynamics.integrate.using_threads``; MuJoCo's rollout with one MjData
+per thread). Rows give body-steps per second and simulated copy-seconds per wall second; the ratio columns divide
+tumble's by MuJoCo's with the same threads (body-steps at the same step, simulated time against MuJoCo at 240 Hz
+for the pile). Every timing is the best of ``--repeat`` runs (fewer once they pass 10 s) after a first, untimed
+one (compile, cache load).
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+import tumble
+from tumble import scenes
+from tumble.dynamics import integrate
+
+from . import peers
+
+__all__ = ["bench_batch", "BatchSizes", "FULL", "QUICK"]
+
+INERTIA = (1.0, 2.0, 3.0)
+OMEGA = (0.01, 5.0, 0.01)
+
+
+@dataclass(frozen=True)
+class BatchSizes:
+    tumbling_copies: int = 4096
+    tumbling_steps: int = 1000
+    pile_copies: int = 1024
+    pile_boxes: int = 10
+    pile_seconds: float = 1.0
+    repeat: int = 3
+
+
+FULL = BatchSizes()
+QUICK = BatchSizes(tumbling_copies=8, tumbling_steps=20, pile_copies=4, pile_boxes=3, pile_seconds=0.05, repeat=1)
+
+
+def _best(run, repeat: int, budget: float = 10.0) -> float:
+    """The best of ``repeat`` timed runs after an untimed one; fewer once the timed runs pass ``budget`` seconds."""
+    run()  # compile, or load from the cache
+    best, spent = math.inf, 0.0
+    for _ in range(repeat):
+        start = time.perf_counter()
+        run()
+        elapsed = time.perf_counter() - start
+        best, spent = min(best, elapsed), spent + elapsed
+        if spent > budget:
+            break
+    return best
+
+
+def _row(scene, engine, config, hz, threads, copies, bodies, steps, seconds) -> dict:
+    return {
+        "scene": scene, "engine": engine, "config": config, "hz": hz, "threads": threads, "copies": copies,
+        "bodies": bodies, "steps": steps, "seconds": seconds,
+        "body_steps_per_s": copies * bodies * steps / seconds, "sim_s_per_s": copies * steps / hz / seconds,
+    }  # fmt: skip
+
+
+def _tumbling_world() -> tumble.World:
+    world = tumble.World(gravity=(0.0, 0.0, 0.0))
+    mass = tumble.MassProperties(1.0, (0.0, 0.0, 0.0), np.diag(INERTIA))
+    world.add_body(mass_properties=mass, angular_velocity=OMEGA)
+    return world
+
+
+def _tumble_rows(scene, world, copies, hz, steps, bodies, repeat) -> list[dict]:
+    rows = []
+    for threads in _thread_counts():
+        batch = tumble.Batch(world, copies)
+
+        def run(batch=batch):
+            batch.reset()
+            batch.step(1.0 / hz, steps=steps)
+
+        with integrate.using_threads(threads):
+            seconds = _best(run, repeat)
+        rows.append(_row(scene, "tumble", f"Batch, {len(batch._blocks)} block(s)", hz, threads, copies, bodies,
+                         steps, seconds))  # fmt: skip
+    return rows
+
+
+def _mujoco_rows(scene, xml, copies, hz, steps, bodies, repeat, config, prepare=None) -> list[dict]:
+    import mujoco
+    from mujoco import rollout
+
+    model, data = peers.load(xml)
+    if prepare is not None:
+        prepare(model, data)
+    spec = mujoco.mjtState.mjSTATE_FULLPHYSICS
+    initial = np.empty((1, mujoco.mj_stateSize(model, spec)))
+    mujoco.mj_getState(model, data, initial[0], spec)
+    initial = np.repeat(initial, copies, axis=0)
+    out = np.empty((copies, steps, initial.shape[1]))
+    rows = []
+    for threads in _thread_counts():
+        datas = [mujoco.MjData(model) for _ in range(threads)]
+
+        def run(datas=datas):
+            rollout.rollout(model, datas, initial, nstep=steps, state=out, persistent_pool=True)
+
+        seconds = _best(run, repeat)
+        rows.append(_row(scene, "MuJoCo", config, hz, threads, copies, bodies, steps, seconds))
+    return rows
+
+
+def _thread_counts() -> list[int]:
+    import os
+
+    return [1, 2] if (os.cpu_count() or 1) >= 2 else [1]
+
+
+def bench_tumbling(sizes: BatchSizes) -> list[dict]:
+    hz = 1000
+    rows = _tumble_rows("tumbling", _tumbling_world(), sizes.tumbling_copies, hz, sizes.tumbling_steps, 1,
+                        sizes.repeat)  # fmt: skip
+    if peers.have_mujoco():
+
+        def spin(model, data):
+            peers.set_free_body_angvel(model, data, np.array([OMEGA]))
+
+        for integrator in ("RK4", "Euler"):
+            xml = peers.tumbling_body_mjcf(integrator, 1.0 / hz, 1.0, INERTIA)
+            rows += _mujoco_rows("tumbling", xml, sizes.tumbling_copies, hz, sizes.tumbling_steps, 1, sizes.repeat,
+                                 integrator, spin)  # fmt: skip
+    return rows
+
+
+def bench_pile(sizes: BatchSizes) -> list[dict]:
+    world = scenes.box_pile(sizes.pile_boxes)
+    model = world.model
+    dynamic = np.flatnonzero(model.body_is_dynamic)
+    bodies = [world.bodies[i] for i in dynamic]
+    rows = _tumble_rows("pile", world, sizes.pile_copies, 60, round(60 * sizes.pile_seconds), len(bodies),
+                        sizes.repeat)  # fmt: skip
+    if peers.have_mujoco():
+        half = np.array([model.shapes[np.flatnonzero(model.shape_body == i)[0]].half_extents for i in dynamic])
+        for hz in (60, 240):
+            xml = peers.boxes_on_plane_mjcf(np.array([b.position for b in bodies]),
+                                            np.array([b.orientation for b in bodies]), half,
+                                            model.body_mass[dynamic], timestep=1.0 / hz, friction=0.5)  # fmt: skip
+            rows += _mujoco_rows("pile", xml, sizes.pile_copies, hz, round(hz * sizes.pile_seconds), len(bodies),
+                                 sizes.repeat, "Newton")  # fmt: skip
+    return rows
+
+
+def with_ratios(rows: list[dict]) -> list[dict]:
+    """Tumble's rows with ``x_<peer>`` columns: its rate over MuJoCo's with the same scene and threads."""
+    for row in rows:
+        if row["engine"] != "tumble":
+            continue
+        for peer in rows:
+            if peer["engine"] == "MuJoCo" and peer["scene"] == row["scene"] and peer["threads"] == row["threads"]:
+                if peer["hz"] == row["hz"]:
+                    row[f"x_mujoco_{peer['config']}_steps"] = row["body_steps_per_s"] / peer["body_steps_per_s"]
+                if row["scene"] == "pile" and peer["hz"] == 240:
+                    row["x_mujoco_240hz_sim_time"] = row["sim_s_per_s"] / peer["sim_s_per_s"]
+    return rows
+
+
+def bench_batch(sizes: BatchSizes = FULL) -> list[dict]:
+    return with_ratios(bench_tumbling(sizes) + bench_pile(sizes))
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m benchmarks.batch", description=__doc__.split("\n\n")[0])
+    parser.add_argument("--quick", action="store_true", help="tiny sizes (a smoke test)")
+    parser.add_argument("--repeat", type=int, help="timed repeats (best is kept)")
+    args = parser.parse_args(argv)
+    sizes = QUICK if args.quick else FULL
+    if args.repeat is not None:
+        sizes = BatchSizes(**{**sizes.__dict__, "repeat": max(1, args.repeat)})
+    for row in bench_batch(sizes):
+        print({k: (f"{v:.4g}" if isinstance(v, float) else v) for k, v in row.items()})
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
