@@ -284,13 +284,7 @@ def _print_run_summary(console, world, scene_path: Path, *, dt, steps, planned, 
                        failed) -> None:  # fmt: skip
     from rich.table import Table
 
-    # Steps/s after the first chunk when there were several (the first pays for loading the compiled kernels).
-    rate_note = "whole run, loading the compiled kernels included"
-    rate = steps / wall if wall > 0 else math.inf
-    if progress.first_chunk is not None and progress.last is not None and progress.last[1] > progress.first_chunk[1]:
-        (t1, s1), (t2, s2) = progress.first_chunk, progress.last
-        if t2 > t1:
-            rate, rate_note = (s2 - s1) / (t2 - t1), "after the first chunk (which loads the compiled kernels)"
+    rate, rate_note = progress.steps_per_second(steps, wall)
     energy_end = world.total_energy()
     drift = (energy_end - energy_0) / max(abs(energy_0), _TINY)
     bodies = world.bodies

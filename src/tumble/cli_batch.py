@@ -88,12 +88,7 @@ def run_batch(args) -> int:
 def _print_summary(console, args, batch, bodies, dt, done, steps, wall, progress, failed) -> None:
     from rich.table import Table
 
-    # Rates after the first chunk when there were several (the first pays for loading the compiled kernels).
-    rate, note = done / wall if wall > 0 else math.inf, "whole run, loading the compiled kernels included"
-    if progress.first_chunk is not None and progress.last is not None and progress.last[1] > progress.first_chunk[1]:
-        (t1, s1), (t2, s2) = progress.first_chunk, progress.last
-        if t2 > t1:
-            rate, note = (s2 - s1) / (t2 - t1), "after the first chunk (which loads the compiled kernels)"
+    rate, note = progress.steps_per_second(done, wall)
     table = Table(title=_text(f"{args.scene}: {args.copies} copies, {'FAILED' if failed else 'done'}"),
                   title_justify="left")  # fmt: skip
     table.add_column("quantity")

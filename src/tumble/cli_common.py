@@ -177,6 +177,15 @@ class _Progress:
         if self._bar is not None:
             self._bar.update(self._task, completed=steps, t=world.time, stage=SIMULATING)
 
+    def steps_per_second(self, steps: int, wall: float) -> tuple[float, str]:
+        """``(steps/s, what it covers)``: after the first chunk when there were several (the first pays for loading
+        the compiled kernels), else ``steps`` over the whole ``wall`` time."""
+        if self.first_chunk is not None and self.last is not None and self.last[1] > self.first_chunk[1]:
+            (t1, s1), (t2, s2) = self.first_chunk, self.last
+            if t2 > t1:
+                return (s2 - s1) / (t2 - t1), "after the first chunk (which loads the compiled kernels)"
+        return (steps / wall if wall > 0 else math.inf), "whole run, loading the compiled kernels included"
+
 
 class _CompileWatch(numba_event.Listener):
     """Calls ``on_compile()`` at the end of each Numba compilation (not for a load from the cache)."""
