@@ -118,8 +118,9 @@ def _refuse_unsupported(world) -> None:
 class Batch:
     """``n`` copies of ``world``'s model, stepped together; see docs/batch.md.
 
-    The batch copies the world's bodies, shapes, joints, solver settings and present state (later changes to the
-    world do not reach it). Copies differ by their state, their applied loads and their :meth:`override` values.
+    The batch copies the world's bodies, shapes, joints, solver settings and present state, warm starts included
+    (later changes to the world do not reach it; loads applied to the world for its next step are not copied). Copies
+    differ by their state, their applied loads and their :meth:`override` values.
 
     Args:
         world: a :class:`~tumble.World` without controllers, actuators, drag, sensors or wind.
