@@ -481,13 +481,17 @@ class Batch:
     def _restart(self, block: _Block, copies: np.ndarray, template: State | None) -> None:
         """The islands, contacts and joint impulses of a block's local ``copies``: the template's, or none."""
         base, state = self._base, block.state
-        bodies, joints = base.body_count, base.joint_count
-        for j in copies.tolist():
-            island = np.full(bodies, -1, np.int64) if template is None else template.body_island
-            state.body_island[j * bodies : (j + 1) * bodies] = np.where(island >= 0, island + j * bodies, -1)
-            for name in ("joint_linear_impulse", "joint_angular_impulse", "joint_drive_impulse"):
-                rows = getattr(state, name)[j * joints : (j + 1) * joints]
-                rows[:] = 0.0 if template is None else getattr(template, name)
+        bodies, k = base.body_count, block.last - block.first
+        islands = state.body_island.reshape(k, bodies)  # a view: rows of the copies
+        if template is None:
+            islands[copies] = -1
+        else:
+            shifted = template.body_island[None, :] + (copies * bodies)[:, None]
+            islands[copies] = np.where(template.body_island >= 0, shifted, -1)
+        for name in ("joint_linear_impulse", "joint_angular_impulse", "joint_drive_impulse"):
+            impulses = getattr(state, name)
+            impulses = impulses.reshape(k, base.joint_count, impulses.shape[1])
+            impulses[copies] = 0.0 if template is None else getattr(template, name)
         splice_contacts(state, copies, template, base.shape_count)
 
     def _per_copy_rows(self, name: str, value, width: int, rows: int) -> np.ndarray:

@@ -124,7 +124,7 @@ def splice_contacts(state: State, copies: np.ndarray, template: State | None, sh
 def copy_impulses(state: State, j: int, shapes: int, joints: int) -> dict[str, np.ndarray]:
     """Local copy ``j``'s contacts and joint impulses in ``state``, numbered as in one world."""
     out = {name: getattr(state, name)[j * joints : (j + 1) * joints].copy() for name in _JOINT_FIELDS}
-    mine = state.contact_shape_a // max(shapes, 1) == j if shapes else np.zeros(state.contact_count, bool)
+    mine = state.contact_shape_a // shapes == j if shapes else np.zeros(state.contact_count, bool)
     for name in _CONTACT_FIELDS:
         out[name] = getattr(state, name)[mine].copy()
     out["contact_shape_a"] -= j * shapes

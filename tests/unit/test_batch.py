@@ -237,8 +237,9 @@ def test_copies_with_their_own_spring_targets_equal_worlds_built_with_them():
 # --- resets, loads, one copy as a world --------------------------------------------------------------
 
 
-def test_reset_returns_chosen_copies_to_the_initial_state_and_replays_them_bit_for_bit():
-    batch = Batch(_pile(1), 4)
+@pytest.mark.parametrize("make", [_pile, _chain], ids=["contacts", "joints"])
+def test_reset_returns_chosen_copies_to_the_initial_state_and_replays_them_bit_for_bit(make):
+    batch = Batch(make(1), 4)  # two blocks: copies 0, 1 and 2, 3
     batch.step(1 / 60, steps=20)
     after_20 = batch.state.copy()
     batch.step(1 / 60, steps=10)
