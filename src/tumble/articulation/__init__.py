@@ -16,6 +16,7 @@ from __future__ import annotations
 
 from .actuators import Actuator
 from .articulation import Articulation, ArticulationTrajectory, Link
+from .batch import ArticulationBatch
 from .joints import Ball, Fixed, Free, Joint, JointType, Prismatic, Revolute
 from .loops import LoopClosure
 
@@ -49,6 +50,7 @@ def from_urdf(path, *, package_dirs=(), floating_base: bool = False) -> Articula
 __all__ = [
     "Actuator",
     "Articulation",
+    "ArticulationBatch",
     "ArticulationTrajectory",
     "Ball",
     "Fixed",

@@ -18,7 +18,16 @@ from .loops import loop_jacobian, project_loop_closures
 from .model import QDD, model_views, work_views
 from .spatial import assign, fill_matrix
 
-__all__ = ["FORWARD", "INVERSE", "KINEMATICS", "MASS_MATRIX", "PROJECT", "SIMULATE", "articulation_kernel"]
+__all__ = [
+    "FORWARD",
+    "INVERSE",
+    "KINEMATICS",
+    "MASS_MATRIX",
+    "PROJECT",
+    "SIMULATE",
+    "articulation_kernel",
+    "batch_kernel",
+]
 
 KINEMATICS, INVERSE, MASS_MATRIX, FORWARD, PROJECT, SIMULATE = 0, 1, 2, 3, 4, 5
 
@@ -93,3 +102,31 @@ def articulation_kernel(ints, reals, q, qd, vec_in, external, use_external, work
         if status != 0:
             return n, status, where
     return steps, 0, -1
+
+
+@kernel
+def batch_kernel(ints, reals, q, qd, tau, work, external, h, method, steps, first, last, failures):  # fmt: skip
+    """``steps`` time steps of copies ``first..last-1`` of one articulation (``ArticulationBatch``); releases the GIL.
+
+    Args:
+        ints, reals: the shared model buffers; work: (copies, work size), one work buffer per copy.
+        q: (copies, nq), qd: (copies, nv): the states, advanced in place; tau: (copies, nv) joint forces held
+            over the steps. external: (n, 6) zeros (no external loads).
+        failures: (copies, 3) int64: ``(step, status, where)`` of each copy's failing step, written only for a
+            copy that fails (it stops there with its state from before that step).
+
+    Returns the number of copies that failed. A copy's arithmetic is :func:`articulation_kernel`'s (the same
+    ``step``), so each copy advances bit for bit as the articulation alone.
+    """
+    m = model_views(ints, reals)
+    failed = 0
+    for c in range(first, last):
+        w = work_views(work[c], ints[0], ints[1], ints[2], ints[3])
+        q_c, qd_c, tau_c = q[c], qd[c], tau[c]
+        for n in range(steps):
+            status, where = step(m, w, q_c, qd_c, tau_c, external, False, h, method)
+            if status != 0:
+                failures[c, 0], failures[c, 1], failures[c, 2] = n, status, where
+                failed += 1
+                break
+    return failed

@@ -1,0 +1,172 @@
+"""Many copies of one articulation stepped together: :class:`ArticulationBatch`.
+
+The copies share the model buffers (``model.py``) and each has its own state row and work buffer; one compiled
+call (``kernels.batch_kernel``) advances every copy by any number of steps, the copies split over the threads of
+``tumble.dynamics.integrate`` (``using_threads``) when there are enough of them. A copy's arithmetic is the
+articulation's own ``step``, so each copy moves bit for bit as the articulation stepped alone.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .._validate import _show, as_array, as_count, as_step
+from ..dynamics.integrate import _thread_pool, threads
+from ..errors import SimulationError
+from .articulation import Articulation, _check_integrator
+from .integrators import NOT_FINITE
+from .kernels import batch_kernel
+from .model import counts, work_size
+
+__all__ = ["ArticulationBatch"]
+
+# Below this many copy-steps a call stays on the calling thread: a hand-off to the pool costs ~20 µs.
+_PARALLEL_MIN_STEPS = 256
+
+
+class ArticulationBatch:
+    """``n`` copies of an articulation, each with its own ``q``, ``qd`` and joint forces, stepped in one call.
+
+    Args:
+        articulation: the :class:`~tumble.articulation.Articulation` to copy: its links, loop closures, gravity,
+            joint damping, springs and actuators (at its present ``ctrl``, the same for every copy) are fixed
+            when the batch is built; every copy starts at its ``q``, ``qd``.
+        n: the number of copies (>= 1).
+
+    Attributes:
+        q: (n, nq) and qd: (n, nv): the copies' coordinates and velocities, row ``c`` copy ``c``'s. Write into them
+            (``batch.q[3] = ...``) or assign whole arrays (validated); quaternions are renormalised on assignment.
+        tau: (n, nv) the joint forces [N m or N] each copy feels, held over the steps until changed (zero at
+            first). For a ``Free`` joint, its six rows are the world-frame force on the link and the torque about
+            the link origin in the link frame.
+        time: [s] the batch's clock.
+
+    >>> from tumble.articulation import Articulation, ArticulationBatch, Revolute
+    >>> pendulum = Articulation()
+    >>> _ = pendulum.add_link(Revolute((0, 1, 0)), mass=1.0, shape_position=(0, 0, -1))
+    >>> batch = ArticulationBatch(pendulum, 3)
+    >>> batch.q[:, 0] = (0.1, 0.2, 0.3)
+    >>> batch.step(0.01, steps=100, integrator="rk4")
+    >>> batch.q.shape
+    (3, 1)
+    """
+
+    def __init__(self, articulation, n) -> None:
+        if not isinstance(articulation, Articulation):
+            raise TypeError(f"articulation must be an Articulation, got {_show(articulation)}")
+        n = as_count("n", n)
+        if not articulation.links:
+            raise ValueError("articulation has no links; add one with add_link")
+        compiled = articulation._compile()
+        self._links = articulation.links
+        self._quat_starts = list(articulation._quat_starts)
+        self._ints, self._reals = compiled.ints.copy(), compiled.reals.copy()
+        links, nq, nv, loops = counts(self._ints)
+        self._work = np.zeros((n, work_size(links, nq, nv, loops)))
+        self._external = np.zeros((links, 6))
+        self._failures = np.zeros((n, 3), dtype=np.int64)
+        self._q = np.ascontiguousarray(np.repeat(articulation.q[None], n, axis=0))
+        self._qd = np.ascontiguousarray(np.repeat(articulation.qd[None], n, axis=0))
+        self._tau = np.zeros((n, nv))
+        self._n = n
+        self.time = float(articulation.time)
+
+    # --- state ---------------------------------------------------------------------------------------
+
+    @property
+    def n(self) -> int:
+        """The number of copies."""
+        return self._n
+
+    @property
+    def nq(self) -> int:
+        return self._q.shape[1]
+
+    @property
+    def nv(self) -> int:
+        return self._qd.shape[1]
+
+    @property
+    def q(self) -> np.ndarray:
+        return self._q
+
+    @q.setter
+    def q(self, value) -> None:
+        q = np.array(as_array("q", value, (self._n, self.nq), batch=False), dtype=np.float64)
+        for start, link in self._quat_starts:
+            norms = np.linalg.norm(q[:, start : start + 4], axis=1)
+            if not np.all(norms > 1e-12):
+                bad = int(np.argmin(norms))
+                raise ValueError(f"q[{bad}, {start}:{start + 4}] (link {link}) must be a non-zero quaternion, "
+                                 f"got {_show(q[bad, start : start + 4])}")  # fmt: skip
+            q[:, start : start + 4] /= norms[:, None]
+        self._q[...] = q
+
+    @property
+    def qd(self) -> np.ndarray:
+        return self._qd
+
+    @qd.setter
+    def qd(self, value) -> None:
+        self._qd[...] = as_array("qd", value, (self._n, self.nv), batch=False)
+
+    @property
+    def tau(self) -> np.ndarray:
+        return self._tau
+
+    @tau.setter
+    def tau(self, value) -> None:
+        self._tau[...] = as_array("tau", value, (self._n, self.nv), batch=False)
+
+    # --- stepping ------------------------------------------------------------------------------------
+
+    def step(self, dt, steps=1, integrator="symplectic") -> None:
+        """Advance every copy by ``steps`` steps of ``dt`` seconds under its joint forces ``tau``, in one call.
+
+        ``integrator``: ``"symplectic"``, ``"rk4"`` or ``"euler"`` (:meth:`Articulation.step`'s). A copy whose state
+        turns non-finite (or whose mass matrix turns singular) raises :class:`~tumble.SimulationError` with
+        ``error.copy`` and ``error.body`` (the link) of the first such copy; every copy then keeps the state it
+        had before the call, and the clock stands.
+        """
+        dt = as_step("dt", dt, self.time)
+        steps = as_count("steps", steps)
+        method = _check_integrator(integrator)
+        if not np.all(np.isfinite(self._tau)):
+            bad = np.argwhere(~np.isfinite(self._tau))[0]
+            raise ValueError(f"tau[{bad[0]}, {bad[1]}] must be finite, got {float(self._tau[tuple(bad)])!r}")
+        before = (self._q.copy(), self._qd.copy())
+        args = (self._ints, self._reals, self._q, self._qd, self._tau, self._work, self._external, dt, method, steps)
+        workers = min(threads(), self._n)
+        if workers < 2 or self._n * steps < _PARALLEL_MIN_STEPS:
+            failed = batch_kernel(*args, 0, self._n, self._failures)
+        else:
+            bounds = np.linspace(0, self._n, workers + 1).astype(np.int64)
+            futures = [_thread_pool().submit(batch_kernel, *args, int(lo), int(hi), self._failures)
+                       for lo, hi in zip(bounds[:-1], bounds[1:], strict=True)]  # fmt: skip
+            failed = sum(f.result() for f in futures)
+        if failed:
+            raise self._failure(before, failed)
+        self.time += steps * dt
+
+    def _failure(self, before, failed: int) -> SimulationError:
+        """Put every copy back to ``before`` and describe the first copy that failed (from its failure row)."""
+        self._q[...], self._qd[...] = before
+        copy = int(np.flatnonzero(self._failures[:, 1])[0])
+        step, status, where = (int(v) for v in self._failures[copy])
+        self._failures[:] = 0
+        if status != NOT_FINITE:  # a singular pivot reports its degree of freedom: name the joint's link
+            where = next(link.index for link in self._links if link.v_slice.start <= where < link.v_slice.stop)
+        link = self._links[where]
+        label = repr(link.name) if link.name is not None else f"#{link.index}"
+        what = "a non-finite coordinate or velocity" if status == NOT_FINITE else "a singular mass matrix"
+        error = SimulationError(
+            f"copy {copy}: link {label} got {what} at step {step} of this call ({failed} of {self._n} copies "
+            "failed); every copy keeps its state from before the call",
+            body=link.name if link.name is not None else link.index,
+            step=step,
+        )
+        error.copy = copy
+        return error
+
+    def __repr__(self) -> str:
+        return f"ArticulationBatch(n={self._n}, nq={self.nq}, nv={self.nv}, time={self.time!r})"

@@ -1,0 +1,180 @@
+"""ArticulationBatch: many copies of an articulation in one call, each bit for bit the articulation alone."""
+
+from __future__ import annotations
+
+import os
+
+import numpy as np
+import pytest
+
+from tumble import SimulationError
+from tumble.articulation import Articulation, ArticulationBatch, Ball, Free, Prismatic, Revolute
+from tumble.dynamics.integrate import using_threads
+from tumble.mass import MassProperties
+from tumble.shapes import Box
+
+COMPILED = os.environ.get("NUMBA_DISABLE_JIT", "0") != "1"
+
+
+def cart_pole() -> Articulation:
+    art = Articulation()
+    cart = art.add_link(Prismatic((1, 0, 0)), mass=1.0, damping=0.05)
+    art.add_link(Revolute((0, 1, 0)), parent=cart, shape=Box((0.04, 0.04, 1.0)), mass=0.1,
+                 shape_position=(0, 0, 0.5))  # fmt: skip
+    return art
+
+
+def ball_chain() -> Articulation:
+    """A ball-jointed link under a hinged one: quaternion coordinates and a spring."""
+    art = Articulation()
+    top = art.add_link(Ball(), shape=Box((0.1, 0.1, 0.6)), mass=1.0, shape_position=(0, 0, -0.3))
+    art.add_link(Revolute((1, 0, 0)), parent=top, position=(0, 0, -0.6), mass=0.5, shape_position=(0, 0, -0.4),
+                 stiffness=3.0, springref=0.2)  # fmt: skip
+    return art
+
+
+def four_bar() -> Articulation:
+    """A crank-rocker closed by a loop (ground 0.55, crank 0.2, coupler 0.6, rocker 0.5 m)."""
+    art = Articulation()
+    crank = art.add_link(Revolute((0, 1, 0)), mass=0.3, shape_position=(0.1, 0, 0))
+    coupler = art.add_link(Revolute((0, 1, 0)), parent=crank, position=(0.2, 0, 0), mass=0.6,
+                           shape_position=(0.3, 0, 0))  # fmt: skip
+    rocker = art.add_link(Revolute((0, 1, 0)), position=(0.55, 0, 0), mass=0.5, shape_position=(0.25, 0, 0))
+    art.add_loop_closure(coupler, (0.6, 0, 0), rocker, (0.5, 0, 0))
+    art.q = [-1.2, 1.0, -1.8]
+    art.project_loop_closures()
+    return art
+
+
+def free_body() -> Articulation:
+    art = Articulation(gravity=(0.0, 0.0, -9.81))
+    art.add_link(Free(), mass_properties=MassProperties(2.0, np.zeros(3), np.diag([0.1, 0.2, 0.3])))
+    art.qd = [0.1, 0.0, 0.2, 1.0, 2.0, 3.0]  # a tumbling throw: the intermediate axis is unstable
+    return art
+
+
+def _spread(art: Articulation, batch: ArticulationBatch, rng) -> None:
+    """Different starts and joint forces per copy (quaternions stay unit: the hinges' rows only)."""
+    quat_rows = {row for start, _ in art._quat_starts for row in range(start, start + 4)}
+    for k in range(art.nq):
+        if k not in quat_rows and not (art.links[0].joint.nq == 7 and k < 3):
+            batch.q[:, k] += rng.uniform(-0.1, 0.1, batch.n)
+    batch.qd[...] += rng.uniform(-0.5, 0.5, batch.qd.shape)
+    batch.tau[...] = rng.uniform(-1.0, 1.0, batch.tau.shape)
+
+
+@pytest.mark.parametrize("build", [cart_pole, ball_chain, four_bar, free_body])
+@pytest.mark.parametrize("integrator", ["rk4", "symplectic", "euler"])
+def test_every_copy_moves_bit_for_bit_as_the_articulation_alone(build, integrator):
+    art = build()
+    batch = ArticulationBatch(art, 5)
+    _spread(art, batch, np.random.default_rng(3))
+    q0, qd0 = batch.q.copy(), batch.qd.copy()
+    batch.step(1e-3, steps=40, integrator=integrator)
+    batch.step(1e-3, steps=10, integrator=integrator)
+    assert batch.time == pytest.approx(0.05, abs=1e-15)
+    for c in range(batch.n):
+        alone = build()
+        alone.q, alone.qd = q0[c], qd0[c]
+        for _ in range(50):
+            alone.step(1e-3, tau=batch.tau[c], integrator=integrator)
+        np.testing.assert_array_equal(batch.q[c], alone.q)
+        np.testing.assert_array_equal(batch.qd[c], alone.qd)
+    assert np.ptp(batch.q[:, -1]) > 0.0  # the copies differ
+
+
+@pytest.mark.skipif(not COMPILED, reason="two threads only matter compiled")
+def test_two_threads_give_the_bits_of_one():
+    art = ball_chain()
+    results = []
+    for count in (1, 2):
+        batch = ArticulationBatch(art, 64)
+        _spread(art, batch, np.random.default_rng(8))
+        with using_threads(min(count, os.cpu_count() or 1)):
+            batch.step(1e-3, steps=20, integrator="rk4")
+        results.append((batch.q.copy(), batch.qd.copy()))
+    np.testing.assert_array_equal(results[0][0], results[1][0])
+    np.testing.assert_array_equal(results[0][1], results[1][1])
+
+
+def test_a_free_links_joint_forces_are_a_world_force_and_a_body_torque():
+    """For a Free joint ``tau`` = (force, world frame; torque about the origin, link frame): a 2 kg body turned
+    90 deg about z, pushed along world x and twisted about its own x axis, accelerates along world x at F/m and
+    spins up about its own x at T/Ixx (from rest, no gyroscopic term)."""
+    art = Articulation(gravity=(0.0, 0.0, 0.0))
+    quarter = (np.cos(np.pi / 4), 0.0, 0.0, np.sin(np.pi / 4))
+    art.add_link(Free(), orientation=quarter,
+                 mass_properties=MassProperties(2.0, np.zeros(3), np.diag([0.1, 0.2, 0.3])))  # fmt: skip
+    batch = ArticulationBatch(art, 2)
+    batch.tau[:] = (4.0, 0.0, 0.0, 0.05, 0.0, 0.0)
+    batch.tau[1] *= 2.0
+    batch.step(1e-3, steps=100, integrator="rk4")
+    for c, scale in enumerate((1.0, 2.0)):
+        np.testing.assert_allclose(batch.qd[c, :3], (scale * 2.0 * 0.1, 0.0, 0.0), atol=1e-12)
+        np.testing.assert_allclose(batch.q[c, :3], (scale * 0.5 * 2.0 * 0.1**2, 0.0, 0.0), atol=1e-12)
+        np.testing.assert_allclose(batch.qd[c, 3:], (scale * 0.5 * 0.1, 0.0, 0.0), atol=1e-12)
+
+
+def test_assigned_states_are_validated_and_quaternions_renormalised():
+    art = ball_chain()
+    batch = ArticulationBatch(art, 3)
+    q = batch.q.copy()
+    q[1, :4] = (2.0, 0.0, 0.0, 0.0)
+    batch.q = q
+    np.testing.assert_array_equal(batch.q[1, :4], (1.0, 0.0, 0.0, 0.0))
+    q[2, :4] = 0.0
+    with pytest.raises(ValueError, match=r"q\[2, 0:4\] \(link 0\) must be a non-zero quaternion"):
+        batch.q = q
+    np.testing.assert_array_equal(batch.q[2, :4], (1.0, 0.0, 0.0, 0.0))  # refused: nothing changed
+    with pytest.raises(ValueError, match="qd"):
+        batch.qd = np.zeros((3, 5))
+    with pytest.raises(ValueError, match="tau"):
+        batch.tau = np.zeros((2, 4))
+
+
+@pytest.mark.parametrize(
+    ("args", "error", "match"),
+    [
+        (("not an articulation", 2), TypeError, "articulation must be an Articulation"),
+        ((Articulation(), 2), ValueError, "no links"),
+        ((cart_pole(), 0), ValueError, "n must be"),
+        ((cart_pole(), 2.5), ValueError, "n must be an integer"),
+    ],
+)
+def test_bad_construction_names_the_argument(args, error, match):
+    with pytest.raises(error, match=match):
+        ArticulationBatch(*args)
+
+
+def test_bad_steps_name_the_argument_and_change_nothing():
+    batch = ArticulationBatch(cart_pole(), 2)
+    batch.q[:, 1] = 0.3
+    with pytest.raises(ValueError, match="integrator must be one of"):
+        batch.step(0.01, integrator="verlet")
+    with pytest.raises(ValueError, match="dt"):
+        batch.step(-0.01)
+    with pytest.raises(ValueError, match="steps must be"):
+        batch.step(0.01, steps=0)
+    batch.tau[1, 0] = np.nan
+    with pytest.raises(ValueError, match=r"tau\[1, 0\] must be finite, got nan"):
+        batch.step(0.01)
+    np.testing.assert_array_equal(batch.q[:, 1], 0.3)
+    assert batch.time == 0.0
+
+
+def test_a_copy_that_blows_up_names_itself_and_every_copy_keeps_its_state():
+    batch = ArticulationBatch(cart_pole(), 4)
+    batch.step(0.01, steps=2)
+    before = (batch.q.copy(), batch.qd.copy(), batch.time)
+    batch.qd[2, 1] = 1e200  # squared in the centripetal terms: overflows
+    qd_set = batch.qd.copy()
+    with pytest.raises(SimulationError, match=r"copy 2: link #\d got a non-finite") as caught:
+        batch.step(0.01, steps=5, integrator="rk4")
+    assert caught.value.copy == 2
+    assert caught.value.body in (0, 1)
+    np.testing.assert_array_equal(batch.q, before[0])
+    np.testing.assert_array_equal(batch.qd, qd_set)
+    assert batch.time == before[2]
+    batch.qd[2, 1] = 0.0
+    batch.step(0.01)  # the others step on
+    assert batch.time > before[2]
