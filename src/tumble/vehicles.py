@@ -27,7 +27,7 @@ from .flight.kernels import allocate_speeds
 from .mass import MassProperties
 from .shapes import Box, Sphere
 
-__all__ = ["CRAZYFLIE", "HUMMINGBIRD", "Mixer", "Quadrotor", "quadrotor_params"]
+__all__ = ["CRAZYFLIE", "HUMMINGBIRD", "Mixer", "Quadrotor", "quadrotor_params", "rotor_hubs"]
 
 _PARAMETER_NAMES = ("mass", "inertia", "arm_length", "k_thrust", "k_moment", "k_drag", "k_inflow", "speed_min",
                     "speed_max", "time_constant", "rotor_directions", "drag_coefficients", "kp_att",
@@ -94,6 +94,13 @@ _LAYOUTS = {
 }
 
 
+def rotor_hubs(layout: str, arm_length: float) -> np.ndarray:
+    """(4, 3) [m] the rotors' hubs in the body frame for ``layout`` ``"x"`` or ``"+"`` (module docstring)."""
+    if layout not in _LAYOUTS:
+        raise ValueError(f"layout must be 'x' or '+', got {layout!r}")
+    return _LAYOUTS[layout] * arm_length
+
+
 class Mixer:
     """The map between the rotors' squared speeds ``ω²`` (4,) and the wrench ``(T, Mx, My, Mz)`` they make: the
     collective thrust along the body's ``z`` [N] and the moments about the centre of mass, body frame [N m].
@@ -154,12 +161,10 @@ class Quadrotor:
         if not isinstance(params, Mapping):
             raise TypeError(f"params must be a mapping such as tumble.vehicles.CRAZYFLIE, got {params!r}")
         self.params = quadrotor_params(**params)
-        if layout not in _LAYOUTS:
-            raise ValueError(f"layout must be 'x' or '+', got {layout!r}")
+        hubs = rotor_hubs(layout, self.params["arm_length"])
         self.layout = layout
         p = self.params
         arm = p["arm_length"]
-        hubs = _LAYOUTS[layout] * arm
         shapes = [(Box((arm, arm, 0.2 * arm)), (0.0, 0.0, 0.0), (1.0, 0.0, 0.0, 0.0))]
         shapes += [(Sphere(0.1 * arm), (x, y, -0.3 * arm), (1.0, 0.0, 0.0, 0.0)) for x, y, _ in hubs]
         self.body = world.add_body(

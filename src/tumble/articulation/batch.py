@@ -62,7 +62,8 @@ class ArticulationBatch:
         self._quat_starts = list(articulation._quat_starts)
         self._ints, self._reals = compiled.ints.copy(), compiled.reals.copy()
         links, nq, nv, loops = counts(self._ints)
-        self._work = np.zeros((n, work_size(links, nq, nv, loops)))
+        self._work_size = work_size(links, nq, nv, loops)
+        self._work = np.zeros((1, self._work_size))  # one work buffer per thread, grown as threads are used
         self._external = np.zeros((links, 6))
         self._failures = np.zeros((n, 3), dtype=np.int64)
         self._q = np.ascontiguousarray(np.repeat(articulation.q[None], n, axis=0))
@@ -94,7 +95,8 @@ class ArticulationBatch:
     def q(self, value) -> None:
         q = np.array(as_array("q", value, (self._n, self.nq), batch=False), dtype=np.float64)
         for start, link in self._quat_starts:
-            norms = np.linalg.norm(q[:, start : start + 4], axis=1)
+            quat = q[:, start : start + 4]  # its norm summed term by term: the same bits for any number of copies
+            norms = np.sqrt(quat[:, 0] ** 2 + quat[:, 1] ** 2 + quat[:, 2] ** 2 + quat[:, 3] ** 2)
             if not np.all(norms > 1e-12):
                 bad = int(np.argmin(norms))
                 raise ValueError(f"q[{bad}, {start}:{start + 4}] (link {link}) must be a non-zero quaternion, "
@@ -131,18 +133,26 @@ class ArticulationBatch:
         dt = as_step("dt", dt, self.time)
         steps = as_count("steps", steps)
         method = _check_integrator(integrator)
-        if not np.all(np.isfinite(self._tau)):
+        if not np.isfinite(self._tau).all():
             bad = np.argwhere(~np.isfinite(self._tau))[0]
             raise ValueError(f"tau[{bad[0]}, {bad[1]}] must be finite, got {float(self._tau[tuple(bad)])!r}")
+        self._advance(dt, steps, method)
+
+    def _advance(self, dt: float, steps: int, method: int) -> None:
+        """:meth:`step` with its arguments already checked (the environments' path: they check their actions)."""
         before = (self._q.copy(), self._qd.copy())
-        args = (self._ints, self._reals, self._q, self._qd, self._tau, self._work, self._external, dt, method, steps)
         workers = min(threads(), self._n)
         if workers < 2 or self._n * steps < _PARALLEL_MIN_STEPS:
-            failed = batch_kernel(*args, 0, self._n, self._failures)
+            failed = batch_kernel(self._ints, self._reals, self._q, self._qd, self._tau, self._work[0], self._external,
+                                  dt, method, steps, 0, self._n, self._failures)  # fmt: skip
         else:
+            if self._work.shape[0] < workers:
+                self._work = np.zeros((workers, self._work_size))
             bounds = np.linspace(0, self._n, workers + 1).astype(np.int64)
-            futures = [_thread_pool().submit(batch_kernel, *args, int(lo), int(hi), self._failures)
-                       for lo, hi in zip(bounds[:-1], bounds[1:], strict=True)]  # fmt: skip
+            futures = [_thread_pool().submit(batch_kernel, self._ints, self._reals, self._q, self._qd, self._tau,
+                                             self._work[k], self._external, dt, method, steps, int(bounds[k]),
+                                             int(bounds[k + 1]), self._failures)
+                       for k in range(workers)]  # fmt: skip
             failed = sum(f.result() for f in futures)
         if failed:
             raise self._failure(before, failed)

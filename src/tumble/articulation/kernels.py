@@ -109,19 +109,20 @@ def batch_kernel(ints, reals, q, qd, tau, work, external, h, method, steps, firs
     """``steps`` time steps of copies ``first..last-1`` of one articulation (``ArticulationBatch``); releases the GIL.
 
     Args:
-        ints, reals: the shared model buffers; work: (copies, work size), one work buffer per copy.
+        ints, reals: the shared model buffers; work: one work buffer (``model.work_size``) for this call's copies.
         q: (copies, nq), qd: (copies, nv): the states, advanced in place; tau: (copies, nv) joint forces held
             over the steps. external: (n, 6) zeros (no external loads).
         failures: (copies, 3) int64: ``(step, status, where)`` of each copy's failing step, written only for a
             copy that fails (it stops there with its state from before that step).
 
     Returns the number of copies that failed. A copy's arithmetic is :func:`articulation_kernel`'s (the same
-    ``step``), so each copy advances bit for bit as the articulation alone.
+    ``step``), so each copy advances bit for bit as the articulation alone: a step reads nothing of the work
+    buffer that it did not write first, so one buffer serves copy after copy (and stays in the cache).
     """
     m = model_views(ints, reals)
+    w = work_views(work, ints[0], ints[1], ints[2], ints[3])
     failed = 0
     for c in range(first, last):
-        w = work_views(work[c], ints[0], ints[1], ints[2], ints[3])
         q_c, qd_c, tau_c = q[c], qd[c], tau[c]
         for n in range(steps):
             status, where = step(m, w, q_c, qd_c, tau_c, external, False, h, method)

@@ -1,0 +1,296 @@
+"""tumble.envs: Gymnasium's API and checker, seeds, native vector envs (autoreset, copies equal single envs), the
+physics of each task against its closed form, rendering and bad input."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+gym = pytest.importorskip("gymnasium")
+
+from gymnasium.utils.env_checker import check_env  # noqa: E402
+from gymnasium.vector import AutoresetMode  # noqa: E402
+
+import tumble.envs  # noqa: E402
+from tumble.envs import TASKS, TumbleEnv, TumbleVectorEnv, make_env, make_vector_env  # noqa: E402
+
+NAMES = tuple(TASKS)
+
+
+def _actions(space, count: int, seed: int) -> list:
+    space.seed(seed)
+    return [space.sample() for _ in range(count)]
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_every_env_passes_gymnasiums_checker(name):
+    env = gym.make(f"tumble/{name}", render_mode="rgb_array")
+    assert isinstance(env.unwrapped, TumbleEnv)
+    check_env(env.unwrapped)
+    assert env.spec.max_episode_steps == TASKS[name].max_episode_steps
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_the_same_seed_gives_the_same_episode(name):
+    episodes = []
+    for _ in range(2):
+        env = gym.make(f"tumble/{name}")
+        observation, _ = env.reset(seed=11)
+        frames = [observation]
+        for action in _actions(env.action_space, 12, seed=5):
+            observation, reward, terminated, truncated, _ = env.step(action)
+            frames.append(np.append(observation, reward))
+            if terminated:
+                break
+        episodes.append(frames)
+    other = gym.make(f"tumble/{name}").reset(seed=12)[0]
+    assert not np.array_equal(episodes[0][0], other)
+    assert len(episodes[0]) == len(episodes[1])
+    for a, b in zip(*episodes, strict=True):
+        np.testing.assert_array_equal(a, b)
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_make_vec_returns_the_native_vector_env(name):
+    envs = gym.make_vec(f"tumble/{name}", num_envs=3, vectorization_mode="vector_entry_point")
+    assert isinstance(envs, TumbleVectorEnv)
+    assert envs.metadata["autoreset_mode"] == AutoresetMode.NEXT_STEP
+    assert envs.max_episode_steps == TASKS[name].max_episode_steps
+    single = make_env(name)
+    assert envs.single_observation_space == single.observation_space
+    assert envs.single_action_space == single.action_space
+    observations, infos = envs.reset(seed=0)
+    assert observations.shape == (3, *single.observation_space.shape)
+    assert observations.dtype == np.float32
+    assert all(observations[c] in single.observation_space for c in range(3))
+    results = envs.step(envs.action_space.sample())
+    assert results[0].shape == observations.shape
+    assert results[1].shape == results[2].shape == results[3].shape == (3,)
+    assert results[2].dtype == results[3].dtype == np.bool_
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_each_vector_copy_equals_a_single_env_stepped_alone(name):
+    """Copies started from the vector env's draws and single envs put in the same states, stepped with the same
+    actions: the same states bit for bit, and the same observations, rewards and terminations, until each copy's
+    episode ends (NumPy's sin and cos may round the last bit differently for arrays of other lengths)."""
+    copies = 4
+    envs = make_vector_env(name, copies)
+    envs.reset(seed=3)
+    q, qd = envs.state
+    envs.set_state(q, qd)  # both sides renormalise their quaternions the same way
+    singles = []
+    for c in range(copies):
+        env = make_env(name)
+        env.reset(seed=100 + c)
+        env.set_state(q[c], qd[c])
+        singles.append(env)
+    live = np.ones(copies, dtype=bool)
+    for actions in _actions(envs.action_space, 10, seed=2):
+        vector = envs.step(actions)
+        for c in np.flatnonzero(live):
+            observation, reward, terminated, _, _ = singles[c].step(actions[c])
+            np.testing.assert_array_equal(envs.state[0][c], singles[c].state[0])
+            np.testing.assert_array_equal(envs.state[1][c], singles[c].state[1])
+            np.testing.assert_allclose(vector[0][c], observation, rtol=1e-6, atol=1e-7)
+            assert vector[1][c] == pytest.approx(reward, rel=1e-13, abs=1e-13)
+            assert vector[2][c] == terminated
+            live[c] = not terminated
+    assert np.any(envs.state[0] != q)
+
+
+def test_autoreset_follows_gymnasiums_next_step_mode():
+    """A copy that terminates or truncates is reset by the next step: its first observation, reward 0, neither flag;
+    its action is ignored and the other copies step on."""
+    envs = make_vector_env("CartPole", 3, max_episode_steps=4)
+    envs.reset(seed=0)
+    push = np.array([1, 1, 1])
+    for _ in range(3):
+        _, rewards, terminated, truncated, _ = envs.step(push)
+        assert not truncated.any() and not terminated.any()
+    _, rewards, terminated, truncated, _ = envs.step(push)
+    assert truncated.all() and not terminated.any()
+    np.testing.assert_array_equal(rewards, 1.0)
+    observations, rewards, terminated, truncated, _ = envs.step(push)
+    np.testing.assert_array_equal(rewards, 0.0)
+    assert not terminated.any() and not truncated.any()
+    assert np.all(np.abs(observations) <= 0.05)  # fresh starts, uniform in ±0.05
+    # a termination: copy 1 pushed over by a tilted start
+    envs = make_vector_env("CartPole", 3)
+    envs.reset(seed=0)
+    q, qd = envs.state
+    q[1, 1] = 0.2  # 11.5°, falling
+    envs.set_state(q, qd)
+    for _ in range(40):
+        observations, rewards, terminated, truncated, _ = envs.step(np.array([1, 0, 1]))
+        if terminated[1]:
+            break
+    assert terminated[1] and not truncated[1] and abs(observations[1, 2]) > 12 * math.pi / 180
+    observations, rewards, terminated, _, _ = envs.step(np.array([1, 0, 1]))
+    assert rewards[1] == 0.0 and not terminated[1] and np.all(np.abs(observations[1]) <= 0.05)
+
+
+def test_a_reset_mask_resets_only_the_chosen_copies():
+    envs = make_vector_env("Pendulum", 4)
+    envs.reset(seed=1)
+    for _ in range(3):
+        envs.step(np.ones((4, 1), dtype=np.float32))
+    before = envs.state[0].copy()
+    mask = np.array([False, True, False, True])
+    observations, _ = envs.reset(options={"reset_mask": mask})
+    after = envs.state[0]
+    np.testing.assert_array_equal(after[~mask], before[~mask])
+    assert np.all(after[mask] != before[mask])
+    assert envs._copies.elapsed.tolist() == [3, 0, 3, 0]
+
+
+def test_cartpole_accelerations_are_gymnasiums_closed_form():
+    """The articulation's accelerations equal CartPole-v1's equations (Florian 2007) at random states and forces."""
+    task = TASKS["CartPole"]()
+    art = task.articulation()
+    g, cart, pole, half = 9.8, 1.0, 0.1, 0.5
+    rng = np.random.default_rng(0)
+    for _ in range(20):
+        x, x_dot, theta, theta_dot = rng.uniform(-2, 2, 4)
+        force = rng.choice((-10.0, 10.0))
+        temp = (force + pole * half * theta_dot**2 * math.sin(theta)) / (cart + pole)
+        theta_acc = (g * math.sin(theta) - math.cos(theta) * temp) / (
+            half * (4.0 / 3.0 - pole * math.cos(theta) ** 2 / (cart + pole))
+        )
+        x_acc = temp - pole * half * theta_acc * math.cos(theta) / (cart + pole)
+        acc = art.forward_dynamics(q=(x, theta), qd=(x_dot, theta_dot), tau=(force, 0.0))
+        np.testing.assert_allclose(acc, (x_acc, theta_acc), rtol=1e-12, atol=1e-12)
+
+
+def test_pendulum_accelerations_are_gymnasiums_closed_form():
+    art = TASKS["Pendulum"]().articulation()
+    for theta, torque in ((0.3, 0.0), (-2.0, 1.5), (3.0, -2.0)):
+        acc = art.forward_dynamics(q=(theta,), qd=(0.7,), tau=(torque,))
+        np.testing.assert_allclose(acc, [3 * 10.0 / 2 * math.sin(theta) + 3.0 * torque], rtol=1e-12)
+
+
+def test_the_double_pendulums_bodies_are_the_mujoco_models():
+    """Masses from the capsules of inverted_double_pendulum.xml at density 1000: the cart (radius 0.1, 0.2 m) and
+    the poles (radius 0.045, 0.6 m); the upright pose puts the tip 1.2 m up and does not terminate."""
+    task = TASKS["DoublePendulum"]()
+    masses = [link.mass_properties.mass for link in task.articulation().links]
+    capsule = [1000 * (math.pi * r * r * length + 4 / 3 * math.pi * r**3) for r, length in ((0.1, 0.2), (0.045, 0.6))]
+    np.testing.assert_allclose(masses, [capsule[0], capsule[1], capsule[1]], rtol=1e-12)
+    x, y = task.tip(np.array([[0.3, 0.0, 0.0], [0.0, math.pi / 2, 0.0]]))
+    np.testing.assert_allclose(x, [0.3, 1.2], atol=1e-12)
+    np.testing.assert_allclose(y, [1.2, 0.0], atol=1e-12)
+    assert task.terminated(np.array([[0.3, 0.0, 0.0], [0.0, math.pi / 2, 0.0]]), np.zeros((2, 3))).tolist() == [
+        False,
+        True,
+    ]
+
+
+def test_the_quadrotor_hovers_at_the_speeds_that_carry_its_weight_and_falls_without_them():
+    task = TASKS["QuadrotorHover"]()
+    p = task.params
+    hover = math.sqrt(p["mass"] * 9.81 / (4 * p["k_thrust"]))
+    action = 2 * (hover - p["speed_min"]) / (p["speed_max"] - p["speed_min"]) - 1
+    env = make_env("QuadrotorHover")
+    env.reset(seed=0)
+    start = np.array([0.1, -0.2, 0.3, 1.0, 0.0, 0.0, 0.0])
+    env.set_state(start, np.zeros(6))
+    for _ in range(50):
+        observation, reward, terminated, _, _ = env.step(np.full(4, action))  # float64: the exact hover speed
+    q, qd = env.state
+    np.testing.assert_allclose(q, start, atol=1e-9)  # held still for 0.5 s
+    np.testing.assert_allclose(qd, 0.0, atol=1e-9)
+    assert reward == pytest.approx(1.0 - np.linalg.norm(start[:3]) - 1e-5 * 2 * abs(action), abs=1e-8)
+    env.set_state(start, np.zeros(6))
+    for _ in range(30):  # rotors at their slowest (zero speed): free fall for 0.3 s
+        env.step(np.full(4, -1.0, dtype=np.float32))
+    q, qd = env.state
+    np.testing.assert_allclose(q[2], 0.3 - 0.5 * 9.81 * 0.3**2, atol=1e-12)
+    np.testing.assert_allclose(qd[2], -9.81 * 0.3, atol=1e-12)
+
+
+def test_the_quadrotor_tilted_by_a_roll_command_turns_about_its_body_x_axis():
+    """Speeds up on the rotors at +y, down on those at -y (layout "x"): a roll moment about body x, the rate
+    Mx/Ixx · t, from rest, with no yaw or pitch."""
+    task = TASKS["QuadrotorHover"]()
+    env = make_env("QuadrotorHover")
+    env.reset(seed=0)
+    env.set_state(np.array([0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0]), np.zeros(6))
+    action = np.array([0.3, -0.3, -0.3, 0.3], dtype=np.float32)  # hubs at (+,+), (+,-), (-,-), (-,+)
+    env.step(action)
+    speeds = task.rotor_speeds(action.astype(np.float64)[None])[0]
+    moment = (task.mixer.matrix @ speeds**2)[1]
+    _, qd = env.state
+    assert moment > 0.0
+    np.testing.assert_allclose(qd[3], moment / task.params["inertia"][0, 0] * 0.01, rtol=1e-6)
+    np.testing.assert_allclose(qd[4:], 0.0, atol=1e-9)
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_rendering_draws_the_state(name):
+    env = make_env(name, render_mode="rgb_array")
+    env.reset(seed=0)
+    first = env.render()
+    assert first.dtype == np.uint8 and first.ndim == 3 and first.shape[2] == 3
+    assert len(np.unique(first.reshape(-1, 3), axis=0)) >= 3  # background and at least two colours
+    q, qd = env.state
+    q = q.copy()
+    q[0] += 0.4
+    env.set_state(q, qd)
+    assert not np.array_equal(env.render(), first)
+    vector = make_vector_env(name, 2, render_mode="rgb_array")
+    vector.reset(seed=0)
+    frames = vector.render()
+    assert len(frames) == 2 and frames[0].shape == first.shape
+    with pytest.warns(UserWarning, match="render_mode"):
+        assert make_env(name).render() is None
+
+
+def test_bad_input_is_refused_with_the_argument_named():
+    with pytest.raises(ValueError, match="render_mode must be None or one of"):
+        make_env("CartPole", render_mode="human")
+    with pytest.raises(ValueError, match="task must be one of"):
+        make_env("Acrobot")
+    with pytest.raises(ValueError, match="num_envs must be a positive integer"):
+        make_vector_env("CartPole", 0)
+    with pytest.raises(ValueError, match="max_episode_steps must be a positive integer"):
+        make_vector_env("CartPole", 2, max_episode_steps=0)
+    envs = make_vector_env("CartPole", 2)
+    with pytest.raises(RuntimeError, match="reset"):
+        envs.step(np.array([0, 1]))
+    envs.reset(seed=0)
+    with pytest.raises(ValueError, match="actions must have 2 rows"):
+        envs.step(np.array([0, 1, 1]))
+    with pytest.raises(ValueError, match=r"actions must be 0 \(push left\) or 1"):
+        envs.step(np.array([0, 2]))
+    with pytest.raises(TypeError, match="seed must be None or an int"):
+        envs.reset(seed=1.5)
+    with pytest.raises(ValueError, match="reset_mask"):
+        envs.reset(options={"reset_mask": np.array([1, 0])})
+    env = make_env("DoublePendulum")
+    env.reset(seed=0)
+    with pytest.raises(ValueError, match="qd"):
+        env.set_state(np.zeros(3), np.zeros(2))
+    before = env.state
+    with pytest.raises(ValueError, match="q"):
+        env.set_state(np.zeros(4), np.zeros(3))
+    np.testing.assert_array_equal(env.state[0], before[0])
+
+
+def test_actions_are_clipped_to_the_action_space():
+    envs = make_vector_env("DoublePendulum", 2)
+    envs.reset(seed=4)
+    state = envs.state
+    first = envs.step(np.array([[1.0], [1.0]], dtype=np.float32))
+    envs.set_state(*state)
+    envs._copies.elapsed[:] = 0
+    second = envs.step(np.array([[7.0], [1.0]], dtype=np.float32))
+    np.testing.assert_array_equal(first[0], second[0])
+
+
+def test_the_module_registers_each_env_once():
+    import importlib
+
+    importlib.reload(tumble.envs)
+    assert {f"tumble/{name}" for name in NAMES} <= set(gym.registry)
