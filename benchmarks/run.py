@@ -30,6 +30,8 @@ Run from the repository root:
                  step (``benchmarks/model_files.py``).
 ``batch``        many copies at once: 4096 copies of a tumbling body and 1024 copies of a 10-box pile in a
                  ``tumble.Batch`` beside ``mujoco.rollout`` with the same copies and threads (``benchmarks/batch.py``).
+``envs``         Gymnasium environments: tumble/CartPole and tumble/DoublePendulum beside InvertedPendulum-v5 and
+                 InvertedDoublePendulum-v5, one env and vector envs of 1, 64 and 1024 copies (``benchmarks/envs.py``).
 ``broad_phase``  world bounds and sort-and-sweep pairs alone, on a pile and a scatter of 1k and 5k shapes
                  (``benchmarks/broad_phase.py``; tumble only: no peer exposes its broad phase).
 
@@ -62,7 +64,7 @@ import numpy as np
 import tumble
 from tumble.dynamics import integrate
 
-from . import articulation, batch, broad_phase, build, contact, first_run, joints, model_files, peers, quadrotor
+from . import articulation, batch, broad_phase, build, contact, envs, first_run, joints, model_files, peers, quadrotor
 
 __all__ = [
     "BENCHMARKS",
@@ -734,6 +736,7 @@ BENCHMARKS: dict[str, Callable[[Sizes], list[dict]]] = {
     "build": build.bench_build,
     "broad_phase": broad_phase.bench_broad_phase,
     "batch": lambda sizes: batch.bench_batch(batch.FULL if sizes.repeat > 1 else batch.QUICK),
+    "envs": lambda sizes: envs.bench_envs(envs.FULL if sizes.repeat > 1 else envs.QUICK),
     "first_run": first_run.bench_first_run,
     "model_files": lambda sizes: model_files.bench_model_files(
         chain_links=100 if sizes.repeat > 1 else 5, repeat=max(1, min(sizes.repeat, 5))

@@ -303,3 +303,18 @@ def test_batch_rows_for_both_scenes_with_ratios_to_mujoco():
     if any(r["engine"] == "MuJoCo" for r in rows):
         assert all("x_mujoco_Euler_steps" in r for r in tumble_rows if r["scene"] == "tumbling")
         assert all("x_mujoco_240hz_sim_time" in r for r in tumble_rows if r["scene"] == "pile")
+
+
+def test_envs_rows_for_every_env_with_ratios_to_mujoco():
+    from benchmarks import envs
+
+    rows = envs.bench_envs(envs.QUICK)
+    _assert_finite_numbers(rows)
+    ours = [r for r in rows if r["engine"] == "tumble"]
+    assert {r["env"] for r in ours} == {"tumble/CartPole", "tumble/DoublePendulum", "tumble/Pendulum",
+                                         "tumble/QuadrotorHover"}  # fmt: skip
+    assert all(r["env_steps_per_s"] > 0 for r in rows)
+    assert {r["copies"] for r in ours if r["kind"] == "vector"} == {1, 4}
+    if any(r["engine"] == "MuJoCo" for r in rows):
+        assert all("x_mujoco_single" in r for r in ours if r["env"] == "tumble/CartPole" and r["kind"] == "single")
+        assert all("x_mujoco_vec4" in r for r in ours if r["env"] == "tumble/DoublePendulum" and r["kind"] == "vector")

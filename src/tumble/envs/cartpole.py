@@ -39,6 +39,8 @@ __all__ = ["CartPoleTask"]
 
 CART_MASS, POLE_MASS, POLE_LENGTH, FORCE = 1.0, 0.1, 1.0, 10.0
 X_LIMIT, ANGLE_LIMIT = 2.4, 12.0 * 2.0 * math.pi / 360.0
+PUSHES = np.array([-FORCE, FORCE])  # the force on the cart [N] of actions 0 and 1
+LIMITS = np.array([X_LIMIT, ANGLE_LIMIT])  # of (x, θ): beyond either the episode ends
 
 
 class CartPoleTask(Task):
@@ -66,10 +68,12 @@ class CartPoleTask(Task):
 
     def prepare(self, actions, q, qd, tau):
         pushes = np.asarray(actions).reshape(-1)
-        right = pushes == 1
-        if (~right & (pushes != 0)).any():
-            raise ValueError(f"actions must be 0 (push left) or 1 (push right), got {pushes.tolist()[:8]}")
-        tau[:, 0] = np.where(right, FORCE, -FORCE)
+        try:  # as unsigned integers, anything but 0 and 1 is out of PUSHES' range (-1 too)
+            if pushes.dtype.kind not in "iub":
+                raise IndexError
+            tau[:, 0] = PUSHES[pushes.astype(np.uintp)]
+        except IndexError:
+            raise ValueError(f"actions must be 0 (push left) or 1 (push right), got {actions!r}") from None
         return pushes
 
     def observe(self, q, qd):
@@ -81,7 +85,7 @@ class CartPoleTask(Task):
         return np.ones(q.shape[0])
 
     def terminated(self, q, qd):
-        return (np.abs(q[:, 0]) > X_LIMIT) | (np.abs(q[:, 1]) > ANGLE_LIMIT)
+        return (np.abs(q) > LIMITS).any(axis=1)
 
     def draw(self, q):
         canvas = Canvas(600, 400, scale=600 / (2 * X_LIMIT), centre=(0.0, 0.6))

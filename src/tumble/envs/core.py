@@ -45,6 +45,7 @@ class Task:
     substeps: int
     integrator: str
     max_episode_steps: int
+    reward_reads_start = False  # whether reward() reads the state before the step (else it gets None)
     observation_space: gym.Space
     action_space: gym.Space
 
@@ -67,7 +68,8 @@ class Task:
         raise NotImplementedError
 
     def reward(self, q0, qd0, actions, q, qd, terminated) -> np.ndarray:
-        """(copies,) the reward of a step from ``(q0, qd0)`` to ``(q, qd)`` under ``actions`` (as they acted)."""
+        """(copies,) the reward of a step from ``(q0, qd0)`` (``None`` unless ``reward_reads_start``) to ``(q, qd)``
+        under ``actions`` (as they acted)."""
         raise NotImplementedError
 
     def terminated(self, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
@@ -127,7 +129,7 @@ class _Copies:
     def step(self, actions: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """One control step of every copy: ``(observations, rewards, terminated, elapsed steps)``."""
         task, batch = self.task, self.batch
-        q0, qd0 = batch.q.copy(), batch.qd.copy()
+        q0, qd0 = (batch.q.copy(), batch.qd.copy()) if task.reward_reads_start else (None, None)
         acting = task.prepare(actions, batch.q, batch.qd, batch.tau)
         batch._advance(self._h, task.substeps, self._method)
         self.elapsed += 1

@@ -40,6 +40,7 @@ MASS, LENGTH, GRAVITY, MAX_TORQUE = 1.0, 1.0, 10.0, 2.0
 class PendulumTask(Task):
     dt, substeps, integrator = 0.05, 1, "rk4"
     max_episode_steps = 200
+    reward_reads_start = True  # Gymnasium's cost is that of the state before the step
     render_fps = 20
 
     def __init__(self) -> None:

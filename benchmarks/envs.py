@@ -1,0 +1,169 @@
+"""Reinforcement-learning environments: tumble's Gymnasium envs beside Gymnasium's MuJoCo ones (issue 29).
+
+Run from the repository root:
+
+    python -m benchmarks.envs [--quick] [--repeat N]
+    python -m benchmarks.run --only envs
+
+Pairs: ``tumble/CartPole`` beside ``InvertedPendulum-v5`` (a cart-pole in MuJoCo, 2 RK4 steps of 0.02 s per env
+step) and ``tumble/DoublePendulum`` beside ``InvertedDoublePendulum-v5`` (the same robot, 5 RK4 steps of 0.01 s);
+``tumble/Pendulum`` and ``tumble/QuadrotorHover`` alone. Each env takes random actions drawn beforehand (the same
+for both engines' copies), resetting when an episode ends:
+
+- one env from ``gymnasium.make`` (with its registration's wrappers), steps per second;
+- vector envs of 1, 64 and 1024 copies: tumble's native one (``vectorization_mode="vector_entry_point"``, on 1 and
+  2 threads) and Gymnasium's ``SyncVectorEnv`` of the MuJoCo env (``vectorization_mode="sync"``; one thread), in
+  env-steps (copies × steps) per second.
+
+Ratios: ``x_mujoco_single`` divides a single tumble env's rate by the single MuJoCo env's; ``x_mujoco_vec64`` a
+tumble vector env's by the 64-copy MuJoCo vector env's (the issue's targets: >= 1 and >= 50 at 1024 copies). Every
+timing is the best of ``--repeat`` runs after a first, untimed one (compile, cache load).
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import time
+from dataclasses import dataclass
+
+
+from tumble.dynamics import integrate
+
+__all__ = ["EnvSizes", "FULL", "QUICK", "bench_envs"]
+
+PAIRS = (("tumble/CartPole", "InvertedPendulum-v5"), ("tumble/DoublePendulum", "InvertedDoublePendulum-v5"),
+         ("tumble/Pendulum", None), ("tumble/QuadrotorHover", None))  # fmt: skip
+
+
+@dataclass(frozen=True)
+class EnvSizes:
+    single_steps: int = 5000
+    vector_copies: tuple = (1, 64, 1024)
+    vector_env_steps: int = 200_000  # copies × steps per timed run (at least 20 steps)
+    mujoco_vector_copies: tuple = (1, 64)
+    repeat: int = 3
+
+
+FULL = EnvSizes()
+QUICK = EnvSizes(single_steps=20, vector_copies=(1, 4), vector_env_steps=40, mujoco_vector_copies=(1, 4), repeat=1)
+
+
+def _best(run, repeat: int, budget: float = 10.0) -> float:
+    run()
+    best, spent = math.inf, 0.0
+    for _ in range(repeat):
+        start = time.perf_counter()
+        run()
+        elapsed = time.perf_counter() - start
+        best, spent = min(best, elapsed), spent + elapsed
+        if spent > budget:
+            break
+    return best
+
+
+def _mujoco_available() -> bool:
+    try:
+        import gymnasium as gym
+
+        gym.make("InvertedPendulum-v5").close()
+    except Exception:  # noqa: BLE001 - MuJoCo or its Gymnasium extras missing: tumble's rows alone
+        return False
+    return True
+
+
+def _single_rate(env_id: str, steps: int, repeat: int) -> float:
+    import gymnasium as gym
+
+    env = gym.make(env_id)
+    env.reset(seed=0)
+    env.action_space.seed(0)
+    actions = [env.action_space.sample() for _ in range(steps)]
+
+    def run():
+        for action in actions:
+            _, _, terminated, truncated, _ = env.step(action)
+            if terminated or truncated:
+                env.reset()
+
+    return steps / _best(run, repeat)
+
+
+def _vector_rate(env_id: str, copies: int, mode: str, env_steps: int, repeat: int) -> float:
+    import gymnasium as gym
+
+    envs = gym.make_vec(env_id, num_envs=copies, vectorization_mode=mode)
+    envs.reset(seed=0)
+    envs.action_space.seed(0)
+    steps = max(20, env_steps // copies)
+    actions = [envs.action_space.sample() for _ in range(min(steps, 50))]
+
+    def run():
+        for k in range(steps):
+            envs.step(actions[k % len(actions)])
+
+    return copies * steps / _best(run, repeat)
+
+
+def _row(env_id, engine, kind, copies, threads, rate) -> dict:
+    return {"env": env_id, "engine": engine, "kind": kind, "copies": copies, "threads": threads,
+            "env_steps_per_s": rate}  # fmt: skip
+
+
+def bench_envs(sizes: EnvSizes = FULL) -> list[dict]:
+    import tumble.envs  # noqa: F401 - registers the environments
+
+    mujoco = _mujoco_available()
+    cores = max(1, min(2, os.cpu_count() or 1))
+    rows = []
+    for ours, theirs in PAIRS:
+        rows.append(_row(ours, "tumble", "single", 1, 1, _single_rate(ours, sizes.single_steps, sizes.repeat)))
+        for copies in sizes.vector_copies:
+            for threads in sorted({1, cores}):
+                with integrate.using_threads(threads):
+                    rate = _vector_rate(ours, copies, "vector_entry_point", sizes.vector_env_steps, sizes.repeat)
+                rows.append(_row(ours, "tumble", "vector", copies, threads, rate))
+        if theirs is None or not mujoco:
+            continue
+        rows.append(_row(theirs, "MuJoCo", "single", 1, 1, _single_rate(theirs, sizes.single_steps, sizes.repeat)))
+        for copies in sizes.mujoco_vector_copies:
+            rate = _vector_rate(theirs, copies, "sync", sizes.vector_env_steps, sizes.repeat)
+            rows.append(_row(theirs, "MuJoCo", "vector", copies, 1, rate))
+    return with_ratios(rows)
+
+
+def with_ratios(rows: list[dict]) -> list[dict]:
+    """Each tumble row of a pair gets its ratio to the MuJoCo single env (single rows) or to the largest MuJoCo
+    vector env (vector rows)."""
+    for ours, theirs in PAIRS:
+        peer = [r for r in rows if r["env"] == theirs]
+        if not peer:
+            continue
+        single = next(r["env_steps_per_s"] for r in peer if r["kind"] == "single")
+        vector = max((r for r in peer if r["kind"] == "vector"), key=lambda r: r["copies"])
+        for row in rows:
+            if row["env"] != ours:
+                continue
+            if row["kind"] == "single":
+                row["x_mujoco_single"] = row["env_steps_per_s"] / single
+            else:
+                row[f"x_mujoco_vec{vector['copies']}"] = row["env_steps_per_s"] / vector["env_steps_per_s"]
+    return rows
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m benchmarks.envs", description=__doc__.split("\n\n")[0])
+    parser.add_argument("--quick", action="store_true", help="tiny sizes (a smoke test)")
+    parser.add_argument("--repeat", type=int, help="timed repeats (best is kept)")
+    args = parser.parse_args(argv)
+    sizes = QUICK if args.quick else FULL
+    if args.repeat is not None:
+        sizes = EnvSizes(**{**sizes.__dict__, "repeat": max(1, args.repeat)})
+    for row in bench_envs(sizes):
+        print({k: (f"{v:.4g}" if isinstance(v, float) else v) for k, v in row.items()})
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
