@@ -28,7 +28,6 @@ import os
 import time
 from dataclasses import dataclass
 
-
 from tumble.dynamics import integrate
 
 __all__ = ["EnvSizes", "FULL", "QUICK", "bench_envs"]
