@@ -40,7 +40,7 @@ PAIRS = (("tumble/CartPole", "InvertedPendulum-v5"), ("tumble/DoublePendulum", "
 class EnvSizes:
     single_steps: int = 5000
     vector_copies: tuple = (1, 64, 1024)
-    vector_env_steps: int = 200_000  # copies × steps per timed run (at least 20 steps)
+    vector_env_steps: int = 200_000  # copies × steps per timed run (20 to 5000 steps)
     mujoco_vector_copies: tuple = (1, 64)
     repeat: int = 3
 
@@ -95,7 +95,7 @@ def _vector_rate(env_id: str, copies: int, mode: str, env_steps: int, repeat: in
     envs = gym.make_vec(env_id, num_envs=copies, vectorization_mode=mode)
     envs.reset(seed=0)
     envs.action_space.seed(0)
-    steps = max(20, env_steps // copies)
+    steps = max(20, min(env_steps // copies, 5000))
     actions = [envs.action_space.sample() for _ in range(min(steps, 50))]
 
     def run():
@@ -110,12 +110,13 @@ def _row(env_id, engine, kind, copies, threads, rate) -> dict:
             "env_steps_per_s": rate}  # fmt: skip
 
 
-def bench_envs(sizes: EnvSizes = FULL) -> list[dict]:
+def bench_envs(sizes: EnvSizes = FULL, report=None) -> list[dict]:
+    """Every row (``report(row)`` as each is measured, when given), with the ratios of :func:`with_ratios`."""
     import tumble.envs  # noqa: F401 - registers the environments
 
     mujoco = _mujoco_available()
     cores = max(1, min(2, os.cpu_count() or 1))
-    rows = []
+    rows = _Rows(report)
     for ours, theirs in PAIRS:
         rows.append(_row(ours, "tumble", "single", 1, 1, _single_rate(ours, sizes.single_steps, sizes.repeat)))
         for copies in sizes.vector_copies:
@@ -129,7 +130,20 @@ def bench_envs(sizes: EnvSizes = FULL) -> list[dict]:
         for copies in sizes.mujoco_vector_copies:
             rate = _vector_rate(theirs, copies, "sync", sizes.vector_env_steps, sizes.repeat)
             rows.append(_row(theirs, "MuJoCo", "vector", copies, 1, rate))
-    return with_ratios(rows)
+    return with_ratios(list(rows))
+
+
+class _Rows(list):
+    """A list that reports each row appended."""
+
+    def __init__(self, report) -> None:
+        super().__init__()
+        self._report = report
+
+    def append(self, row) -> None:
+        super().append(row)
+        if self._report is not None:
+            self._report(row)
 
 
 def with_ratios(rows: list[dict]) -> list[dict]:
@@ -159,8 +173,15 @@ def main(argv: list[str] | None = None) -> int:
     sizes = QUICK if args.quick else FULL
     if args.repeat is not None:
         sizes = EnvSizes(**{**sizes.__dict__, "repeat": max(1, args.repeat)})
-    for row in bench_envs(sizes):
-        print({k: (f"{v:.4g}" if isinstance(v, float) else v) for k, v in row.items()})
+
+    def show(row):
+        print({k: (f"{v:.4g}" if isinstance(v, float) else v) for k, v in row.items()}, flush=True)
+
+    rows = bench_envs(sizes, report=show)
+    print("ratios:")
+    for row in rows:
+        if any(key.startswith("x_") for key in row):
+            show(row)
     return 0
 
 
