@@ -3,8 +3,8 @@
 Not run in CI: it needs stable-baselines3 and PyTorch (``pip install stable-baselines3``), and minutes of training.
 Eight copies of ``tumble/CartPole`` feed PPO with its default hyperparameters; each episode's return is logged by
 SB3's ``Monitor`` and the learning curve (the mean return of the last 20 episodes against the timesteps) is written
-to ``out/cartpole_sb3.csv`` and ``out/cartpole_sb3.png``. The run recorded in docs/envs.md reaches the 500-step
-limit (return 500) within 100 000 timesteps.
+to ``out/cartpole_sb3.csv`` and ``out/cartpole_sb3.png``. The run recorded in docs/envs.md (seed 0) climbs from a
+mean return of 20 to 386 (of 500 at most) in 114 688 timesteps, seven PPO updates.
 
 Run: ``python examples/rl/train_cartpole_sb3.py``.
 """
