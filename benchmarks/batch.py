@@ -34,7 +34,7 @@ from tumble.dynamics import integrate
 
 from . import peers
 
-__all__ = ["bench_batch", "BatchSizes", "FULL", "QUICK"]
+__all__ = ["bench_batch", "BatchSizes", "FULL", "QUICK", "best_time"]
 
 INERTIA = (1.0, 2.0, 3.0)
 OMEGA = (0.01, 5.0, 0.01)
@@ -54,7 +54,7 @@ FULL = BatchSizes()
 QUICK = BatchSizes(tumbling_copies=8, tumbling_steps=20, pile_copies=4, pile_boxes=3, pile_seconds=0.05, repeat=1)
 
 
-def _best(run, repeat: int, budget: float = 10.0) -> float:
+def best_time(run, repeat: int, budget: float = 10.0) -> float:
     """The best of ``repeat`` timed runs after an untimed one; fewer once the timed runs pass ``budget`` seconds."""
     run()  # compile, or load from the cache
     best, spent = math.inf, 0.0
@@ -93,7 +93,7 @@ def _tumble_rows(scene, world, copies, hz, steps, bodies, repeat) -> list[dict]:
             batch.step(1.0 / hz, steps=steps)
 
         with integrate.using_threads(threads):
-            seconds = _best(run, repeat)
+            seconds = best_time(run, repeat)
         rows.append(_row(scene, "tumble", f"Batch, {len(batch._blocks)} block(s)", hz, threads, copies, bodies,
                          steps, seconds))  # fmt: skip
     return rows
@@ -118,7 +118,7 @@ def _mujoco_rows(scene, xml, copies, hz, steps, bodies, repeat, config, prepare=
         def run(datas=datas):
             rollout.rollout(model, datas, initial, nstep=steps, state=out, persistent_pool=True)
 
-        seconds = _best(run, repeat)
+        seconds = best_time(run, repeat)
         rows.append(_row(scene, "MuJoCo", config, hz, threads, copies, bodies, steps, seconds))
     return rows
 

@@ -23,12 +23,12 @@ timing is the best of ``--repeat`` runs after a first, untimed one (compile, cac
 from __future__ import annotations
 
 import argparse
-import math
 import os
-import time
 from dataclasses import dataclass
 
 from tumble.dynamics import integrate
+
+from .batch import best_time
 
 __all__ = ["EnvSizes", "FULL", "QUICK", "bench_envs"]
 
@@ -47,19 +47,6 @@ class EnvSizes:
 
 FULL = EnvSizes()
 QUICK = EnvSizes(single_steps=20, vector_copies=(1, 4), vector_env_steps=40, mujoco_vector_copies=(1, 4), repeat=1)
-
-
-def _best(run, repeat: int, budget: float = 10.0) -> float:
-    run()
-    best, spent = math.inf, 0.0
-    for _ in range(repeat):
-        start = time.perf_counter()
-        run()
-        elapsed = time.perf_counter() - start
-        best, spent = min(best, elapsed), spent + elapsed
-        if spent > budget:
-            break
-    return best
 
 
 def _mujoco_available() -> bool:
@@ -86,7 +73,7 @@ def _single_rate(env_id: str, steps: int, repeat: int) -> float:
             if terminated or truncated:
                 env.reset()
 
-    return steps / _best(run, repeat)
+    return steps / best_time(run, repeat)
 
 
 def _vector_rate(env_id: str, copies: int, mode: str, env_steps: int, repeat: int) -> float:
@@ -102,7 +89,7 @@ def _vector_rate(env_id: str, copies: int, mode: str, env_steps: int, repeat: in
         for k in range(steps):
             envs.step(actions[k % len(actions)])
 
-    return copies * steps / _best(run, repeat)
+    return copies * steps / best_time(run, repeat)
 
 
 def _row(env_id, engine, kind, copies, threads, rate) -> dict:

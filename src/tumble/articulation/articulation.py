@@ -664,14 +664,7 @@ class Articulation:
         return np.ascontiguousarray(as_array(name, value, (size,), batch=False), dtype=np.float64).copy()
 
     def _check_q(self, name: str, value) -> np.ndarray:
-        q = self._check_vector(name, value, self.nq)
-        for start, link in self._quat_starts:
-            norm = float(np.linalg.norm(q[start : start + 4]))
-            if not norm > 1e-12:
-                raise ValueError(f"{name}[{start}:{start + 4}] (link {link}) must be a non-zero quaternion, "
-                                 f"got {_show(q[start : start + 4])}")  # fmt: skip
-            q[start : start + 4] /= norm
-        return q
+        return unit_quaternions(name, self._check_vector(name, value, self.nq), self._quat_starts)
 
     def _check_external(self, value) -> np.ndarray:
         return np.ascontiguousarray(as_array("external", value, (len(self._links), 6), batch=False)).copy()
@@ -680,6 +673,24 @@ class Articulation:
         label = f"{self.name!r}, " if self.name is not None else ""
         return (f"Articulation({label}links={len(self._links)}, nq={self.nq}, nv={self.nv}, "
                 f"loop_closures={len(self._loops)}, time={self._time!r})")  # fmt: skip
+
+
+def unit_quaternions(name: str, q: np.ndarray, quat_starts) -> np.ndarray:
+    """``q`` (nq,) or (copies, nq), changed in place, with each joint quaternion (``quat_starts``: (first row, link)
+    pairs) divided by its norm; a zero or non-finite one raises, naming it. The norm is summed term by term, so a
+    row gets the same bits alone or among many (``np.linalg.norm`` may sum in another order)."""
+    rows = q.reshape(-1, q.shape[-1])
+    for start, link in quat_starts:
+        quat = rows[:, start : start + 4]
+        norms = np.sqrt(quat[:, 0] ** 2 + quat[:, 1] ** 2 + quat[:, 2] ** 2 + quat[:, 3] ** 2)
+        usable = norms > 1e-12
+        if not usable.all():
+            bad = int(np.argmin(usable))
+            where = f"{bad}, " if q.ndim == 2 else ""
+            raise ValueError(f"{name}[{where}{start}:{start + 4}] (link {link}) must be a non-zero quaternion, "
+                             f"got {_show(quat[bad])}")  # fmt: skip
+        quat /= norms[:, None]
+    return q
 
 
 def _check_integrator(integrator) -> int:

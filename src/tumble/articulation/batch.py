@@ -13,7 +13,7 @@ import numpy as np
 from .._validate import _show, as_array, as_count, as_step
 from ..dynamics.integrate import _thread_pool, threads
 from ..errors import SimulationError
-from .articulation import Articulation, _check_integrator
+from .articulation import Articulation, _check_integrator, unit_quaternions
 from .integrators import NOT_FINITE
 from .kernels import batch_kernel
 from .model import counts, work_size
@@ -94,15 +94,7 @@ class ArticulationBatch:
     @q.setter
     def q(self, value) -> None:
         q = np.array(as_array("q", value, (self._n, self.nq), batch=False), dtype=np.float64)
-        for start, link in self._quat_starts:
-            quat = q[:, start : start + 4]  # its norm summed term by term: the same bits for any number of copies
-            norms = np.sqrt(quat[:, 0] ** 2 + quat[:, 1] ** 2 + quat[:, 2] ** 2 + quat[:, 3] ** 2)
-            if not np.all(norms > 1e-12):
-                bad = int(np.argmin(norms))
-                raise ValueError(f"q[{bad}, {start}:{start + 4}] (link {link}) must be a non-zero quaternion, "
-                                 f"got {_show(q[bad, start : start + 4])}")  # fmt: skip
-            q[:, start : start + 4] /= norms[:, None]
-        self._q[...] = q
+        self._q[...] = unit_quaternions("q", q, self._quat_starts)
 
     @property
     def qd(self) -> np.ndarray:
