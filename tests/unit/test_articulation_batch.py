@@ -139,6 +139,7 @@ def test_assigned_states_are_validated_and_quaternions_renormalised():
         ((Articulation(), 2), ValueError, "no links"),
         ((cart_pole(), 0), ValueError, "n must be"),
         ((cart_pole(), 2.5), ValueError, "n must be an integer"),
+        ((cart_pole(), 2**31 - 1), ValueError, r"n=2147483647 copies of a 2-coordinate articulation would take"),
     ],
 )
 def test_bad_construction_names_the_argument(args, error, match):

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._validate import _show, as_array, as_count, as_step
+from .._validate import _show, as_array, as_count, as_step, require_memory
 from ..dynamics.integrate import _thread_pool, threads
 from ..errors import SimulationError
 from .articulation import Articulation, _check_integrator, unit_quaternions
@@ -62,6 +62,9 @@ class ArticulationBatch:
         self._quat_starts = list(articulation._quat_starts)
         self._ints, self._reals = compiled.ints.copy(), compiled.reals.copy()
         links, nq, nv, loops = counts(self._ints)
+        # each copy: q, qd and tau (8 bytes an entry), and its failure row (3 int64)
+        need = 8.0 * n * (nq + 2 * nv + 3)
+        require_memory(need, f"n={n} copies of a {nq}-coordinate articulation", "use fewer copies")
         self._work_size = work_size(links, nq, nv, loops)
         self._work = np.zeros((1, self._work_size))  # one work buffer per thread, grown as threads are used
         self._external = np.zeros((links, 6))
