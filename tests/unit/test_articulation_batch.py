@@ -179,3 +179,23 @@ def test_a_copy_that_blows_up_names_itself_and_every_copy_keeps_its_state():
     batch.qd[2, 1] = 0.0
     batch.step(0.01)  # the others step on
     assert batch.time > before[2]
+
+
+@pytest.mark.parametrize("dt", [1 / 60, 1 / 240, 1e-3])
+@pytest.mark.parametrize("steps", [1, 16])
+def test_copies_match_the_articulation_at_every_rate_and_steps_per_call(dt, steps):
+    """The same bits at 60 Hz, 240 Hz and 1 kHz, whether a call takes 1 or 16 steps."""
+    art = cart_pole()
+    batch = ArticulationBatch(art, 3)
+    _spread(art, batch, np.random.default_rng(1))
+    q0, qd0 = batch.q.copy(), batch.qd.copy()
+    for _ in range(32 // steps):
+        batch.step(dt, steps=steps, integrator="rk4")
+    for c in range(batch.n):
+        alone = cart_pole()
+        alone.q, alone.qd = q0[c], qd0[c]
+        for _ in range(32):
+            alone.step(dt, tau=batch.tau[c], integrator="rk4")
+        np.testing.assert_array_equal(batch.q[c], alone.q)
+        np.testing.assert_array_equal(batch.qd[c], alone.qd)
+    assert batch.time == pytest.approx(32 * dt, rel=1e-12)
