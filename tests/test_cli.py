@@ -422,7 +422,8 @@ def test_warmup_steps_every_scene_and_reports_failures(tmp_path, monkeypatch, ca
     monkeypatch.setattr(scene_file, "shipped", lambda: [shipped["pendulum"], shipped["dzhanibekov"]])
     assert cli.main(["warmup", "--jobs", "1"]) == cli.EXIT_OK
     err = capsys.readouterr().err
-    assert "2 of 2 scenes warmed" in err and "1 process at a time" in err
+    assert "3 of 3 warmed (the scenes and the articulation kernels)" in err and "1 process at a time" in err
+    assert "warmed articulation kernels (1/3" in err  # first, in a process of its own
     with pytest.raises(ValueError, match="jobs must be an integer >= 1, got 0"):
         warmup.warmup(0)
     with pytest.raises(SystemExit) as exit_info:  # argparse refuses it, with the status of bad input

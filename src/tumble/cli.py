@@ -565,7 +565,8 @@ def _cmd_warmup(args) -> int:
     results = warmup(jobs, on_done=done)
     failed = [r for r in results if r.error is not None]
     if not args.quiet or failed:
-        _note(f"{len(results) - len(failed)} of {len(results)} scenes warmed in {time.perf_counter() - began:.1f} s "
+        _note(f"{len(results) - len(failed)} of {len(results)} warmed (the scenes and the articulation kernels) in "
+              f"{time.perf_counter() - began:.1f} s "
               f"with {jobs} process{'es' if jobs > 1 else ''} at a time")  # fmt: skip
     return EXIT_SIMULATION if failed else EXIT_OK
 

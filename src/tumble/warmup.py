@@ -8,6 +8,11 @@ process, so that two cores compile two different sets of kernels at once; the re
 compiled, follow in ``jobs`` processes that each step several scenes (a process of its own cost each about 1 s of
 start-up and loading).
 
+Two kernels no scene reaches, those of :class:`~tumble.articulation.Articulation` and
+:class:`~tumble.articulation.ArticulationBatch` (what the Gymnasium environments of ``tumble.envs`` step), are warmed
+first in a process of their own by running a small articulation (:func:`warm_articulations`; about 25 s of compiling
+each, otherwise paid by the first ``simulate`` or environment step).
+
 ``make install`` runs it once; after that, ``tumble run`` of any scene starts at once.
 """
 
@@ -23,7 +28,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
-__all__ = ["WarmedScene", "warm_scene", "warmup", "default_jobs"]
+__all__ = ["WarmedScene", "warm_articulations", "warm_scene", "warmup", "default_jobs"]
 
 # Scenes that need kernels of their own, first, each in its own process: the flagship (contacts of every primitive
 # pair, meshes, hulls, joints), the quadrotor (rotors, flights, wind), the arm (articulation), the free-body
@@ -32,6 +37,8 @@ FIRST = ("flagship", "quadrotor_figure_eight_wind", "robot_arm", "dzhanibekov", 
 # [s] of each scene's simulated time: kernels are compiled as stages are first reached (the flagship's bodies reach
 # the bowl after about 0.3 s: 3 steps compiled 311 functions, 1 s 349, the whole 8 s 351).
 WARM_SECONDS = 1.0
+# The item of the warm-up list that stands for the articulation kernels (warm_articulations), not a scene file.
+ARTICULATIONS = Path(":articulations")
 
 
 @dataclass(frozen=True)
@@ -59,6 +66,26 @@ def warm_scene(path: str | os.PathLike) -> None:
     world.step(dt)
 
 
+def warm_articulations() -> None:
+    """Compile the articulation kernels, which no scene reaches: ``Articulation.simulate`` (whose kernel also answers
+    ``step`` and the queries) and ``ArticulationBatch.step``, on a slider, a hinge and a ball joint."""
+    from .articulation import Articulation, ArticulationBatch, Ball, Prismatic, Revolute
+    from .shapes import Box
+
+    art = Articulation()
+    cart = art.add_link(Prismatic((1.0, 0.0, 0.0)), mass=1.0)
+    pole = art.add_link(Revolute((0.0, 1.0, 0.0)), parent=cart, mass=0.5, shape_position=(0.0, 0.0, 0.5))
+    art.add_link(Ball(), parent=pole, position=(0.0, 0.0, 1.0), shape=Box((0.1, 0.1, 0.4)), mass=0.2,
+                 shape_position=(0.0, 0.0, 0.2))  # fmt: skip
+    art.simulate(0.01, 1e-3)
+    ArticulationBatch(art, 2).step(1e-3)
+
+
+def _name(path) -> str:
+    """What the reports call a warm-up item."""
+    return "articulation kernels" if Path(path) == ARTICULATIONS else Path(path).stem
+
+
 def _batches(scenes: list[Path], jobs: int) -> list[list[Path]]:
     """The processes to run, in order: each of :data:`FIRST` alone (in that order), then the other scenes in name
     order, dealt out to ``jobs`` processes."""
@@ -72,13 +99,16 @@ def warmup(jobs: int | None = None, *, scenes: list[Path] | None = None,
            on_done: Callable[[WarmedScene, int, int], None] | None = None) -> list[WarmedScene]:  # fmt: skip
     """Warm the kernels of ``scenes`` (default: every shipped scene) in ``jobs`` processes at a time (default: one
     per core); ``on_done(result, done, total)`` is called for each scene as its process ends. Returns one result
-    per scene."""
+    per scene. Warming every shipped scene (``scenes`` not given) warms the articulation kernels too, first, as an
+    item of its own (:data:`ARTICULATIONS`)."""
     from . import scene_file
 
     jobs = default_jobs() if jobs is None else jobs
     if isinstance(jobs, bool) or not isinstance(jobs, int) or jobs < 1:
         raise ValueError(f"jobs must be an integer >= 1, got {jobs!r}")
     queue = _batches(list(scene_file.shipped()) if scenes is None else [Path(p) for p in scenes], jobs)
+    if scenes is None:
+        queue.insert(0, [ARTICULATIONS])
     total = sum(len(batch) for batch in queue)
     running: list[_Process] = []
     results: list[WarmedScene] = []
@@ -117,7 +147,7 @@ class _Process:
         self._out.close()
         self._err.close()
         crash = stderr[-1] if stderr else f"exit status {self._child.returncode}"
-        return reported + [WarmedScene(p.stem, 0.0, crash) for p in self.paths[len(reported) :]]
+        return reported + [WarmedScene(_name(p), 0.0, crash) for p in self.paths[len(reported) :]]
 
 
 def _warm_each(paths: list[str]) -> None:
@@ -125,11 +155,11 @@ def _warm_each(paths: list[str]) -> None:
     for path in paths:
         began, error = time.perf_counter(), None
         try:
-            warm_scene(path)
+            warm_articulations() if Path(path) == ARTICULATIONS else warm_scene(path)
         except Exception as exc:  # reported to the parent, which names the scene
             error = f"{type(exc).__name__}: {exc}"
         seconds = time.perf_counter() - began
-        print(json.dumps({"name": Path(path).stem, "seconds": seconds, "error": error}), flush=True)
+        print(json.dumps({"name": _name(path), "seconds": seconds, "error": error}), flush=True)
 
 
 if __name__ == "__main__":  # scenes in a process of their own (see warmup)
