@@ -15,6 +15,7 @@ from gymnasium.vector import AutoresetMode  # noqa: E402
 
 import tumble.envs  # noqa: E402
 from tumble.envs import TASKS, TumbleEnv, TumbleVectorEnv, make_env, make_vector_env  # noqa: E402
+from tumble.vehicles import rotor_hubs  # noqa: E402
 
 NAMES = tuple(TASKS)
 
@@ -210,21 +211,50 @@ def test_the_quadrotor_hovers_at_the_speeds_that_carry_its_weight_and_falls_with
     np.testing.assert_allclose(qd[2], -9.81 * 0.3, atol=1e-12)
 
 
-def test_the_quadrotor_tilted_by_a_roll_command_turns_about_its_body_x_axis():
-    """Speeds up on the rotors at +y, down on those at -y (layout "x"): a roll moment about body x, the rate
-    Mx/Ixx · t, from rest, with no yaw or pitch."""
+@pytest.mark.parametrize(
+    ("axis", "action"),
+    [(0, (0.3, -0.3, -0.3, 0.3)), (1, (-0.3, -0.3, 0.3, 0.3)), (2, (0.3, -0.3, 0.3, -0.3))],
+    ids=["roll", "pitch", "yaw"],
+)
+def test_the_quadrotor_turns_about_the_body_axis_its_rotors_push(axis, action):
+    """Rotor speeds that differ across an axis (layout "x": hubs at (+,+), (+,-), (-,-), (-,+)) or between the two
+    spin directions: the body rate about that axis grows at M/I from rest, M from the rotors' geometry
+    (Mx = kt Σ ω² y, My = -kt Σ ω² x, Mz = km Σ spin ω²), and the other two rates stay zero."""
     task = TASKS["QuadrotorHover"]()
+    p = task.params
     env = make_env("QuadrotorHover")
     env.reset(seed=0)
     env.set_state(np.array([0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0]), np.zeros(6))
-    action = np.array([0.3, -0.3, -0.3, 0.3], dtype=np.float32)  # hubs at (+,+), (+,-), (-,-), (-,+)
+    action = np.array(action)
     env.step(action)
-    speeds = task.rotor_speeds(action.astype(np.float64)[None])[0]
-    moment = (task.mixer.matrix @ speeds**2)[1]
-    _, qd = env.state
-    assert moment > 0.0
-    np.testing.assert_allclose(qd[3], moment / task.params["inertia"][0, 0] * 0.01, rtol=1e-6)
-    np.testing.assert_allclose(qd[4:], 0.0, atol=1e-9)
+    squared = task.rotor_speeds(action[None])[0] ** 2
+    hubs = rotor_hubs("x", p["arm_length"])
+    moments = (p["k_thrust"] * squared @ hubs[:, 1], -p["k_thrust"] * squared @ hubs[:, 0],
+               p["k_moment"] * squared @ np.asarray(p["rotor_directions"], dtype=float))  # fmt: skip
+    rates = env.state[1][3:]
+    assert abs(moments[axis]) > 1e-6
+    np.testing.assert_allclose(rates[axis], moments[axis] / p["inertia"][axis, axis] * 0.01, rtol=1e-6)
+    np.testing.assert_allclose(np.delete(rates, axis), 0.0, atol=1e-9)
+
+
+def test_a_tilted_quadrotors_thrust_pushes_along_its_body_z_axis():
+    """Tilted 30° about x with every rotor at the hover speed: the thrust 4 kt ω² along the body z axis,
+    (0, -sin 30°, cos 30°) in the world, plus gravity, accelerates it from rest; RK4 integrates the constant
+    acceleration exactly."""
+    task = TASKS["QuadrotorHover"]()
+    p = task.params
+    hover = math.sqrt(p["mass"] * 9.81 / (4 * p["k_thrust"]))
+    action = 2 * (hover - p["speed_min"]) / (p["speed_max"] - p["speed_min"]) - 1
+    env = make_env("QuadrotorHover")
+    env.reset(seed=0)
+    tilt = math.radians(30.0)
+    env.set_state(np.array([0.0, 0.0, 0.0, math.cos(tilt / 2), math.sin(tilt / 2), 0.0, 0.0]), np.zeros(6))
+    env.step(np.full(4, action))
+    thrust = 4 * p["k_thrust"] * task.rotor_speeds(np.full((1, 4), action))[0, 0] ** 2
+    expected = thrust / p["mass"] * np.array([0.0, -math.sin(tilt), math.cos(tilt)]) + (0.0, 0.0, -9.81)
+    np.testing.assert_allclose(env.state[1][:3], expected * 0.01, atol=1e-12)
+    np.testing.assert_allclose(env.state[1][3:], 0.0, atol=1e-12)
+    assert expected[1] < -4.0  # it slides towards -y
 
 
 @pytest.mark.parametrize("name", NAMES)
