@@ -21,9 +21,6 @@ one (compile, cache load).
 
 from __future__ import annotations
 
-import argparse
-import math
-import time
 from dataclasses import dataclass
 
 import numpy as np
@@ -33,8 +30,9 @@ from tumble import scenes
 from tumble.dynamics import integrate
 
 from . import peers
+from .timing import best_time, show_row, sizes_from_args
 
-__all__ = ["bench_batch", "BatchSizes", "FULL", "QUICK", "best_time"]
+__all__ = ["bench_batch", "BatchSizes", "FULL", "QUICK"]
 
 INERTIA = (1.0, 2.0, 3.0)
 OMEGA = (0.01, 5.0, 0.01)
@@ -52,20 +50,6 @@ class BatchSizes:
 
 FULL = BatchSizes()
 QUICK = BatchSizes(tumbling_copies=8, tumbling_steps=20, pile_copies=4, pile_boxes=3, pile_seconds=0.05, repeat=1)
-
-
-def best_time(run, repeat: int, budget: float = 10.0) -> float:
-    """The best of ``repeat`` timed runs after an untimed one; fewer once the timed runs pass ``budget`` seconds."""
-    run()  # compile, or load from the cache
-    best, spent = math.inf, 0.0
-    for _ in range(repeat):
-        start = time.perf_counter()
-        run()
-        elapsed = time.perf_counter() - start
-        best, spent = min(best, elapsed), spent + elapsed
-        if spent > budget:
-            break
-    return best
 
 
 def _row(scene, engine, config, hz, threads, copies, bodies, steps, seconds) -> dict:
@@ -182,15 +166,8 @@ def bench_batch(sizes: BatchSizes = FULL) -> list[dict]:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m benchmarks.batch", description=__doc__.split("\n\n")[0])
-    parser.add_argument("--quick", action="store_true", help="tiny sizes (a smoke test)")
-    parser.add_argument("--repeat", type=int, help="timed repeats (best is kept)")
-    args = parser.parse_args(argv)
-    sizes = QUICK if args.quick else FULL
-    if args.repeat is not None:
-        sizes = BatchSizes(**{**sizes.__dict__, "repeat": max(1, args.repeat)})
-    for row in bench_batch(sizes):
-        print({k: (f"{v:.4g}" if isinstance(v, float) else v) for k, v in row.items()})
+    for row in bench_batch(sizes_from_args(argv, "python -m benchmarks.batch", __doc__, FULL, QUICK)):
+        show_row(row)
     return 0
 
 

@@ -22,13 +22,12 @@ timing is the best of ``--repeat`` runs after a first, untimed one (compile, cac
 
 from __future__ import annotations
 
-import argparse
 import os
 from dataclasses import dataclass
 
 from tumble.dynamics import integrate
 
-from .batch import best_time
+from .timing import best_time, show_row, sizes_from_args
 
 __all__ = ["EnvSizes", "FULL", "QUICK", "bench_envs"]
 
@@ -153,22 +152,11 @@ def with_ratios(rows: list[dict]) -> list[dict]:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m benchmarks.envs", description=__doc__.split("\n\n")[0])
-    parser.add_argument("--quick", action="store_true", help="tiny sizes (a smoke test)")
-    parser.add_argument("--repeat", type=int, help="timed repeats (best is kept)")
-    args = parser.parse_args(argv)
-    sizes = QUICK if args.quick else FULL
-    if args.repeat is not None:
-        sizes = EnvSizes(**{**sizes.__dict__, "repeat": max(1, args.repeat)})
-
-    def show(row):
-        print({k: (f"{v:.4g}" if isinstance(v, float) else v) for k, v in row.items()}, flush=True)
-
-    rows = bench_envs(sizes, report=show)
+    rows = bench_envs(sizes_from_args(argv, "python -m benchmarks.envs", __doc__, FULL, QUICK), report=show_row)
     print("ratios:")
     for row in rows:
         if any(key.startswith("x_") for key in row):
-            show(row)
+            show_row(row)
     return 0
 
 
