@@ -205,10 +205,12 @@ def test_the_quadrotor_hovers_at_the_speeds_that_carry_its_weight_and_falls_with
     assert reward == pytest.approx(1.0 - np.linalg.norm(start[:3]) - 1e-5 * 2 * abs(action), abs=1e-8)
     env.set_state(start, np.zeros(6))
     for _ in range(30):  # rotors at their slowest (zero speed): free fall for 0.3 s
-        env.step(np.full(4, -1.0, dtype=np.float32))
+        _, reward, *_ = env.step(np.full(4, -1.0, dtype=np.float32))
     q, qd = env.state
     np.testing.assert_allclose(q[2], 0.3 - 0.5 * 9.81 * 0.3**2, atol=1e-12)
     np.testing.assert_allclose(qd[2], -9.81 * 0.3, atol=1e-12)
+    # the cost: distance, half the speed, half the body rate (none) and 1e-5 |a| (|a| = 2)
+    assert reward == pytest.approx(1.0 - np.linalg.norm(q[:3]) - 0.5 * 9.81 * 0.3 - 2e-5, abs=1e-12)
 
 
 @pytest.mark.parametrize(
@@ -226,15 +228,17 @@ def test_the_quadrotor_turns_about_the_body_axis_its_rotors_push(axis, action):
     env.reset(seed=0)
     env.set_state(np.array([0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0]), np.zeros(6))
     action = np.array(action)
-    env.step(action)
+    _, reward, *_ = env.step(action)
     squared = task.rotor_speeds(action[None])[0] ** 2
     hubs = rotor_hubs("x", p["arm_length"])
     moments = (p["k_thrust"] * squared @ hubs[:, 1], -p["k_thrust"] * squared @ hubs[:, 0],
                p["k_moment"] * squared @ np.asarray(p["rotor_directions"], dtype=float))  # fmt: skip
-    rates = env.state[1][3:]
+    (q, qd), rates = env.state, env.state[1][3:]
     assert abs(moments[axis]) > 1e-6
     np.testing.assert_allclose(rates[axis], moments[axis] / p["inertia"][axis, axis] * 0.01, rtol=1e-6)
     np.testing.assert_allclose(np.delete(rates, axis), 0.0, atol=1e-9)
+    cost = np.linalg.norm(q[:3]) + 0.5 * np.linalg.norm(qd[:3]) + 0.5 * np.linalg.norm(rates)
+    assert reward == pytest.approx(1.0 - cost - 1e-5 * np.linalg.norm(action), abs=1e-12)
 
 
 def test_a_tilted_quadrotors_thrust_pushes_along_its_body_z_axis():
