@@ -455,6 +455,64 @@ def test_batch_steps_copies_of_a_scene_and_reports_body_steps_per_second(folder)
     assert re.search(r"3 dynamic bodies each", result.stdout), result.stdout
 
 
+BLOCK = REPO / "tests" / "data" / "sliding_block.toml"
+
+
+def test_sweep_runs_a_grid_writes_the_table_and_resumes(tmp_path):
+    out = tmp_path / "sweep"
+    args = ("sweep", BLOCK, "--param", "materials.surface.friction=0.3:0.6:2", "-p", "world.gravity[2]=-9.81,-3.71",
+            "--duration", "0.5", "--workers", "2", "--out", out, "--quiet")  # fmt: skip
+    result = tumble_cli(*args)
+    assert result.returncode == 0, result.stderr
+    assert "4 members, 4 done, 0 failed" in result.stdout and "every row in" in result.stdout
+    rows = (out / "results.csv").read_text().splitlines()
+    assert rows[0].startswith("member,materials.surface.friction,world.gravity[2],status,error,time,")
+    assert [row.split(",")[:4] for row in rows[1:]] == [
+        ["0", "0.3", "-9.81", "done"], ["1", "0.3", "-3.71", "done"], ["2", "0.6", "-9.81", "done"],
+        ["3", "0.6", "-3.71", "done"],
+    ]  # fmt: skip
+    trajectory = Trajectory.load(out / "member_00002.h5")
+    assert trajectory.metadata["scene"]["materials"]["surface"]["friction"] == 0.6  # the member's scene, stored
+    # Coulomb: after 0.5 s at mu = 0.6 and g = 9.81 the block has stopped, 2^2 / (2 mu g) from its start.
+    assert trajectory.position[-1, 0, 0] == pytest.approx(4.0 / (2 * 0.6 * 9.81), abs=1e-3)
+    (out / "member_00001.h5").unlink()
+    again = tumble_cli(*args)
+    assert again.returncode == 0, again.stderr
+    assert "4 members, 4 done, 0 failed (3 from an earlier run)" in again.stdout
+
+
+def test_sweep_draws_samples_from_a_seed(tmp_path):
+    from tumble import ensemble
+
+    result = tumble_cli("sweep", BLOCK, "-p", "materials.surface.friction=0.2:0.8", "-p", "world.dt=0.01,0.005",
+                        "--samples", "3", "--seed", "7", "--duration", "0.2", "-j", "1", "--out", tmp_path,
+                        "-q")  # fmt: skip
+    assert result.returncode == 0, result.stderr
+    expected = ensemble.sample(3, seed=7, uniform={"materials.surface.friction": (0.2, 0.8)},
+                               choice={"world.dt": [0.01, 0.005]})  # fmt: skip
+    rows = [row.split(",") for row in (tmp_path / "results.csv").read_text().splitlines()[1:]]
+    assert [(float(r[1]), float(r[2])) for r in rows] == [
+        (m["materials.surface.friction"], m["world.dt"]) for m in expected
+    ]
+
+
+def test_sweep_refuses_bad_input_and_reports_failed_members(tmp_path):
+    blocker = tmp_path / "file"
+    blocker.write_text("")
+    base = ("sweep", BLOCK, "--duration", "0.2", "-j", "1", "-q")
+    assert_clean_failure(tumble_cli(*base, "-p", "materials.surface.frictoin=0.1,0.2", "--out", tmp_path / "a"), 2,
+                         "--param: sliding_block.toml: materials.surface.frictoin: unknown key")  # fmt: skip
+    assert_clean_failure(tumble_cli(*base, "-p", "materials.surface.friction=0.1:0.2", "--out", tmp_path / "a"), 2,
+                         "a range is LOW:HIGH:N")  # fmt: skip
+    assert_clean_failure(tumble_cli(*base, "-p", "world.dt=0.01", "--out", blocker / "x"), 2,
+                         "--out", "cannot write there: Not a directory")  # fmt: skip
+    assert_clean_failure(tumble_cli(*base, "-p", "world.dt=0.01", "--out", tmp_path / "b", "--workers", "2",
+                                    "--scheduler", "tcp://127.0.0.1:1"), 2, "not allowed with argument")  # fmt: skip
+    result = tumble_cli(*base, "-p", "world.gravity[2]=-9.81,-1e308", "--out", tmp_path / "c")
+    assert result.returncode == 1 and "Traceback" not in result.stderr, result.stderr
+    assert "2 members, 1 done, 1 failed" in result.stdout and "SimulationError" in result.stdout
+
+
 def test_batch_refuses_what_it_cannot_step_and_names_it(folder):
     assert_clean_failure(tumble_cli("batch", folder / "small.toml", "-n", "0"), 2, "-n", "0")
     assert_clean_failure(tumble_cli("batch", folder / "small.toml"), 2, "-n")

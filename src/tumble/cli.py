@@ -705,6 +705,10 @@ def build_parser() -> argparse.ArgumentParser:
 
     add_batch_command(commands, _positive_int, _positive_float)
 
+    from .cli_sweep import add_command as add_sweep_command
+
+    add_sweep_command(commands, _positive_int, _positive_float)
+
     info = commands.add_parser("info", help="the bodies, joints and settings of a scene file",
                                description="Load a scene file and print its bodies (mass, centre of mass, principal "
                                "moments and axes), joints and settings.")  # fmt: skip

@@ -27,6 +27,8 @@ __all__ = [
     "H5Frames",
     "is_hdf5_path",
     "read",
+    "read_h5_metadata",
+    "update_h5_metadata",
     "write_npz",
 ]
 
@@ -236,6 +238,22 @@ def _read_h5(path) -> tuple[dict, list[str], dict]:
         arrays[k] = arrays[k][:count]
     arrays["channels"] = {name: value[:count] for name, value in channels.items()}
     return arrays, names, metadata
+
+
+def read_h5_metadata(path) -> dict:
+    """The metadata of the HDF5 trajectory file at ``path`` alone (no frames read)."""
+    with _h5py().File(path, "r") as f:
+        if f.attrs.get("format") != FORMAT_NAME:
+            raise ValueError(f"{os.fspath(path)!r} is not a tumble trajectory")
+        return json.loads(f.attrs.get("metadata", "{}"))
+
+
+def update_h5_metadata(path, entries: dict) -> None:
+    """Add ``entries`` to the metadata of the (closed) HDF5 trajectory file at ``path``."""
+    with _h5py().File(path, "r+") as f:
+        metadata = json.loads(f.attrs.get("metadata", "{}"))
+        metadata.update(entries)
+        f.attrs["metadata"] = metadata_to_json(metadata)
 
 
 def read(path: str | os.PathLike) -> tuple[dict, list[str], dict]:

@@ -18,6 +18,7 @@ import json
 import reprlib
 import tomllib
 import warnings
+from collections.abc import Mapping
 from contextlib import contextmanager
 from dataclasses import dataclass
 from functools import cached_property
@@ -28,8 +29,20 @@ from pydantic import ValidationError
 from . import schema
 from .build import SceneError, build_world
 from .dump import world_to_scene
+from .overrides import apply as apply_overrides
 
-__all__ = ["LoadedScene", "RunSettings", "SceneError", "dumps", "from_dict", "load", "shipped", "shipped_scene"]
+__all__ = [
+    "LoadedScene",
+    "RunSettings",
+    "SceneError",
+    "check",
+    "dumps",
+    "from_dict",
+    "load",
+    "read",
+    "shipped",
+    "shipped_scene",
+]
 
 SHIPPED_DIR = Path(__file__).resolve().parent.parent / "scene_files"
 
@@ -124,23 +137,36 @@ def _without_cyclic_gc():
             gc.enable()
 
 
-def from_dict(data: dict, *, base: Path | str = ".", label: str = "<scene>") -> LoadedScene:
-    """Validate and build a scene given as a dict (``label`` names it in errors; meshes relative to ``base``)."""
+def _validated(data: dict, label: str, overrides: Mapping[str, object] | None = None) -> schema.Scene:
+    """The scene ``data`` validated, with ``overrides`` (place: value) applied to it first: on the scene with every
+    default filled in, which is validated once more after."""
     if not isinstance(data, dict):
         raise SceneError(f"{label}: a scene must be a table (a dict), got {type(data).__name__}")
+    try:
+        scene = schema.Scene.model_validate(data)
+        if overrides:
+            changed = apply_overrides(scene.model_dump(mode="json", exclude_none=True), overrides, label)
+            scene = schema.Scene.model_validate(changed)
+    except ValidationError as error:
+        raise SceneError(_validation_message(label, error)) from None
+    except RecursionError:  # a dict nested thousands deep
+        raise SceneError(f"{label}: nested too deeply to be a scene") from None
+    return scene
+
+
+def from_dict(data: dict, *, base: Path | str = ".", label: str = "<scene>",
+              overrides: Mapping[str, object] | None = None) -> LoadedScene:  # fmt: skip
+    """Validate and build a scene given as a dict (``label`` names it in errors; meshes relative to ``base``).
+    ``overrides`` changes values by their place first (``{"bodies[0].friction": 0.3}``: see
+    :mod:`tumble.scene_file.overrides`)."""
     with _without_cyclic_gc():
-        try:
-            scene = schema.Scene.model_validate(data)
-        except ValidationError as error:
-            raise SceneError(_validation_message(label, error)) from None
-        except RecursionError:  # a dict nested thousands deep
-            raise SceneError(f"{label}: nested too deeply to be a scene") from None
+        scene = _validated(data, label, overrides)
         world = build_world(scene, Path(base), label)
     run = RunSettings(scene.world.dt, scene.world.duration, scene.recording.every, scene.recording.path)
     return LoadedScene(world, run, scene)
 
 
-def _model_scene(path: Path) -> LoadedScene:
+def _model_scene_data(path: Path) -> dict:
     """A model file (MJCF or URDF) as a scene of that one model, with its gravity and its timestep as the step (a
     URDF has neither: MuJoCo's defaults, 9.81 m/s² down and 2 ms)."""
     from ..models.mjcf import MJCFError, read_mjcf
@@ -152,17 +178,17 @@ def _model_scene(path: Path) -> LoadedScene:
             model = read_urdf(path) if path.suffix.lower() == ".urdf" else read_mjcf(path)
     except (MJCFError, OSError) as error:
         raise SceneError(str(error)) from None
-    data = {"world": {"gravity": model.gravity.tolist(), "dt": float(model.timestep)}, "models": [{"path": path.name}]}
-    return from_dict(data, base=path.parent, label=path.name)
+    return {"world": {"gravity": model.gravity.tolist(), "dt": float(model.timestep)}, "models": [{"path": path.name}]}
 
 
-def load(path) -> LoadedScene:
-    """Read, validate and build the scene file at ``path`` (``.toml`` or ``.json``, or a model file: MJCF ``.xml``,
-    URDF ``.urdf``)."""
+def read(path) -> tuple[dict, Path, str]:
+    """``(data, base, label)``: the file at ``path`` parsed (not yet validated), the folder its meshes and models
+    are relative to, and its name for errors. A model file (MJCF ``.xml``, URDF ``.urdf``) reads as a scene of that
+    one model."""
     path = Path(path)
     label = path.name
     if path.suffix.lower() in (".xml", ".urdf"):
-        return _model_scene(path)
+        return _model_scene_data(path), path.parent, label
     if path.suffix not in (".toml", ".json"):
         raise SceneError(f"{label}: a scene file must end in .toml or .json (or be a model file: MJCF .xml, URDF "
                          ".urdf)")  # fmt: skip
@@ -181,7 +207,22 @@ def load(path) -> LoadedScene:
             raise SceneError(f"{label}: not valid {path.suffix[1:].upper()}: {error}") from None
         except RecursionError:
             raise SceneError(f"{label}: not valid {path.suffix[1:].upper()}: nested too deeply") from None
-        return from_dict(data, base=path.parent, label=label)
+    return data, path.parent, label
+
+
+def load(path, overrides: Mapping[str, object] | None = None) -> LoadedScene:
+    """Read, validate and build the scene file at ``path`` (``.toml`` or ``.json``, or a model file: MJCF ``.xml``,
+    URDF ``.urdf``), with ``overrides`` (place: value, ``{"bodies[0].friction": 0.3}``) changed in it first."""
+    data, base, label = read(path)
+    return from_dict(data, base=base, label=label, overrides=overrides)
+
+
+def check(path, overrides: Mapping[str, object] | None = None) -> schema.Scene:
+    """Read and validate the scene file at ``path`` with ``overrides`` applied, without building it (cheap: the
+    check of a sweep's places before its members run). Raises :class:`SceneError` as :func:`load` does."""
+    data, _, label = read(path)
+    with _without_cyclic_gc():
+        return _validated(data, label, overrides)
 
 
 def dumps(scene: dict, format: str = "toml") -> str:
