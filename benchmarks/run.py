@@ -32,6 +32,9 @@ Run from the repository root:
                  ``tumble.Batch`` beside ``mujoco.rollout`` with the same copies and threads (``benchmarks/batch.py``).
 ``envs``         Gymnasium environments: tumble/CartPole and tumble/DoublePendulum beside InvertedPendulum-v5 and
                  InvertedDoublePendulum-v5, one env and vector envs of 1, 64 and 1024 copies (``benchmarks/envs.py``).
+``ensemble``     64 members of the box pile through ``tumble.ensemble.run`` on a local process pool and a Dask
+                 LocalCluster with 1 and 2 workers, beside a serial loop: the scaling efficiency
+                 (``benchmarks/ensembles.py``).
 ``broad_phase``  world bounds and sort-and-sweep pairs alone, on a pile and a scatter of 1k and 5k shapes
                  (``benchmarks/broad_phase.py``; tumble only: no peer exposes its broad phase).
 
@@ -64,7 +67,20 @@ import numpy as np
 import tumble
 from tumble.dynamics import integrate
 
-from . import articulation, batch, broad_phase, build, contact, envs, first_run, joints, model_files, peers, quadrotor
+from . import (
+    articulation,
+    batch,
+    broad_phase,
+    build,
+    contact,
+    ensembles,
+    envs,
+    first_run,
+    joints,
+    model_files,
+    peers,
+    quadrotor,
+)
 
 __all__ = [
     "BENCHMARKS",
@@ -617,6 +633,10 @@ def check_targets(results: dict[str, list[dict]]) -> list[dict]:
             add(f"quadrotor {row['rate_hz']} Hz, SE3 every step: steps/s vs RotorPy (x)", row["x_rotorpy"], ">= 100",
                 row["x_rotorpy"] >= 100)  # fmt: skip
     targets += _build_targets(results.get("build", []))
+    for row in results.get("ensemble", []):
+        if "efficiency" in row:
+            add(f"ensemble of {row['members']} members, {row['executor']}: 1 worker's time over 2 x 2 workers'",
+                row["efficiency"], ">= 0.8", row["efficiency"] >= 0.8)  # fmt: skip
     return targets
 
 
@@ -737,6 +757,7 @@ BENCHMARKS: dict[str, Callable[[Sizes], list[dict]]] = {
     "broad_phase": broad_phase.bench_broad_phase,
     "batch": lambda sizes: batch.bench_batch(batch.FULL if sizes.repeat > 1 else batch.QUICK),
     "envs": lambda sizes: envs.bench_envs(envs.FULL if sizes.repeat > 1 else envs.QUICK),
+    "ensemble": lambda sizes: ensembles.bench_ensemble(ensembles.FULL if sizes.repeat > 1 else ensembles.QUICK),
     "first_run": first_run.bench_first_run,
     "model_files": lambda sizes: model_files.bench_model_files(
         chain_links=100 if sizes.repeat > 1 else 5, repeat=max(1, min(sizes.repeat, 5))

@@ -318,3 +318,14 @@ def test_envs_rows_for_every_env_with_ratios_to_mujoco():
     if any(r["engine"] == "MuJoCo" for r in rows):
         assert all("x_mujoco_single" in r for r in ours if r["env"] == "tumble/CartPole" and r["kind"] == "single")
         assert all("x_mujoco_vec4" in r for r in ours if r["env"] == "tumble/DoublePendulum" and r["kind"] == "vector")
+
+
+def test_ensemble_rows_for_the_pool_and_dask_with_their_efficiency():
+    from benchmarks import ensembles
+
+    rows = ensembles.bench_ensemble(ensembles.QUICK)
+    _assert_finite_numbers(rows)
+    executors = {(r["executor"], r["workers"]) for r in rows}
+    assert {("serial loop", 1), ("local pool", 1), ("local pool", 2)} <= executors
+    assert all(r["members"] == 4 and r["members_per_s"] > 0 for r in rows)
+    assert all("efficiency" in r for r in rows if r["workers"] == 2)

@@ -455,7 +455,7 @@ def test_batch_steps_copies_of_a_scene_and_reports_body_steps_per_second(folder)
     assert re.search(r"3 dynamic bodies each", result.stdout), result.stdout
 
 
-BLOCK = REPO / "tests" / "data" / "sliding_block.toml"
+BLOCK = scene_file.shipped_scene("sliding_block")
 
 
 def test_sweep_runs_a_grid_writes_the_table_and_resumes(tmp_path):

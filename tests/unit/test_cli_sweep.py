@@ -3,16 +3,14 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import pytest
 
-from tumble import cli
+from tumble import cli, scene_file
 from tumble.cli_common import BadInput
 from tumble.cli_sweep import parse_param
 from tumble.ensemble import executors
 
-BLOCK = Path(__file__).resolve().parent.parent / "data" / "sliding_block.toml"
+BLOCK = scene_file.shipped_scene("sliding_block")
 
 
 @pytest.mark.parametrize(

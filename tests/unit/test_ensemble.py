@@ -19,7 +19,7 @@ from tumble.ensemble import executors
 from tumble.ensemble.member import member_path
 from tumble.trajectory import Trajectory
 
-BLOCK = Path(__file__).resolve().parent.parent / "data" / "sliding_block.toml"
+BLOCK = scene_file.shipped_scene("sliding_block")
 SPEED = 2.0  # the block's start speed in the file [m/s]
 FRICTION = "materials.surface.friction"
 GRAVITY = "world.gravity[2]"

@@ -3,8 +3,6 @@ build their members with."""
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import pytest
 
@@ -12,7 +10,7 @@ from tumble import scene_file
 from tumble.scene_file import SceneError
 from tumble.scene_file.overrides import apply, parse_place
 
-BLOCK = Path(__file__).resolve().parent.parent / "data" / "sliding_block.toml"
+BLOCK = scene_file.shipped_scene("sliding_block")
 
 
 @pytest.mark.parametrize(
