@@ -5,8 +5,11 @@ The Dask side (a LocalCluster of two worker processes) is in tests/peers/test_en
 
 from __future__ import annotations
 
+import io
 import os
+import re
 import signal
+import time
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
@@ -15,6 +18,7 @@ import pytest
 
 import tumble
 from tumble import ensemble, scene_file
+from tumble.dynamics import integrate
 from tumble.ensemble import executors
 from tumble.ensemble.member import member_path
 from tumble.trajectory import Trajectory
@@ -64,8 +68,20 @@ def killing_world(friction: float, gravity: float, marker: str) -> tumble.World:
     return block_world(friction, gravity)
 
 
+def flaky_world(friction: float, gravity: float, marker: str) -> tumble.World:
+    """Fails the first time it is called (``marker`` records that), then builds the block."""
+    if not os.path.exists(marker):
+        Path(marker).write_text("failed once")
+        raise RuntimeError("first try")
+    return block_world(friction, gravity)
+
+
 def travelled(world) -> dict:
     return {"x": float(world.state.body_pos[0, 0]), "vx": float(world.state.body_linvel[0, 0])}
+
+
+def threads_in_worker(world) -> dict:
+    return {"threads": integrate.threads()}
 
 
 MEMBERS = ensemble.grid({FRICTION: [0.3, 0.6], GRAVITY: [-9.81, -3.71]})
@@ -146,7 +162,9 @@ def test_local_pool_equals_a_serial_loop_and_coulombs_law(tmp_path):
 @runs_members
 def test_a_function_building_worlds_runs_as_the_same_scene(tmp_path):
     members = [{"friction": m[FRICTION], "gravity": m[GRAVITY]} for m in MEMBERS]
-    table = _rows(ensemble.run(block_world, members, DURATION, DT, tmp_path, workers=1, record_every=4))
+    table = _rows(ensemble.run(block_world, members, DURATION, DT, tmp_path, workers=1, record_every=4,
+                               summary=threads_in_worker))  # fmt: skip
+    assert all(row["threads"] == 1 for row in table)  # the pool's workers share the cores: one thread each
     for row, member in zip(table, MEMBERS, strict=True):
         assert row["max_displacement"] == pytest.approx(_slid(member[FRICTION], -member[GRAVITY], DURATION), abs=1e-3)
         assert len(Trajectory.load(row["path"])) == 61  # 240 steps, one frame in 4, and the first
@@ -155,8 +173,10 @@ def test_a_function_building_worlds_runs_as_the_same_scene(tmp_path):
 @runs_members
 def test_any_executor_gives_the_same_table(tmp_path):
     pool = _rows(ensemble.run(BLOCK, MEMBERS, DURATION, DT, tmp_path / "a", workers=2))
+    before = integrate.threads()
     with ThreadPoolExecutor(max_workers=2) as threads:
         threaded = _rows(ensemble.run(BLOCK, MEMBERS, DURATION, DT, tmp_path / "b", executor=threads))
+    assert integrate.threads() == before  # this process's setting is its own
     for one, two in zip(pool, threaded, strict=True):
         for name in ("wall_s", "path"):
             one.pop(name), two.pop(name)
@@ -182,6 +202,9 @@ def test_a_failing_member_is_reported_and_costs_no_other(tmp_path):
     table = _rows(ensemble.run(failing_world, members, DURATION, DT, tmp_path, executor=ThreadPoolExecutor(2)))
     assert [row["status"] for row in table] == ["done", "failed", "failed", "done"]
     assert table[1]["error"] == "RuntimeError: no such material" and table[1]["path"] is None
+    report = (tmp_path / "member_00001.failed.txt").read_text()
+    assert report.startswith("member 1, parameters {'friction': 0.7") and "Traceback" in report
+    assert 'raise RuntimeError("no such material")' in report
     assert table[2]["error"].startswith("SimulationError: ") and "non-finite" in table[2]["error"]
     assert table[2]["path"] == str(member_path(tmp_path, 2, "failed"))
     failed = Trajectory.load(table[2]["path"])
@@ -216,6 +239,16 @@ def test_a_killed_worker_loses_no_finished_member_and_a_rerun_completes(tmp_path
 
 
 @runs_members
+def test_a_member_that_succeeds_on_a_rerun_leaves_no_failure_behind(tmp_path):
+    members = [{"friction": 0.5, "gravity": -9.81, "marker": str(tmp_path / "marker")}]
+    first = _rows(ensemble.run(flaky_world, members, DURATION, DT, tmp_path, executor=ThreadPoolExecutor(1)))
+    assert first[0]["error"] == "RuntimeError: first try" and (tmp_path / "member_00000.failed.txt").exists()
+    again = _rows(ensemble.run(flaky_world, members, DURATION, DT, tmp_path, executor=ThreadPoolExecutor(1)))
+    assert again[0]["status"] == "done" and again[0]["error"] is None
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["marker", "member_00000.h5", "results.csv"]
+
+
+@runs_members
 def test_nothing_half_written_is_taken_as_finished(tmp_path):
     ensemble.run(BLOCK, MEMBERS[:1], DURATION, DT, tmp_path, executor=ThreadPoolExecutor(1))
     whole = member_path(tmp_path, 0)
@@ -233,12 +266,18 @@ def test_nothing_half_written_is_taken_as_finished(tmp_path):
     assert all(Trajectory.load(row["path"]).metadata["status"] == "complete" for row in table)
 
 
-@runs_members
-def test_progress_bar_counts_done_and_failed(tmp_path, capsys):
-    members = [{"friction": 0.3, "gravity": -9.81}, {"friction": 0.7, "gravity": -9.81}]
-    ensemble.run(failing_world, members, DURATION, DT, tmp_path, executor=ThreadPoolExecutor(1), progress=True)
-    bar = ensemble.runner._ProgressBar(3, 1, enabled=False)
-    bar.advance(True), bar.advance(False)
+def test_the_progress_bar_shows_members_done_and_failed_and_the_time_left():
+    from rich.console import Console
+
+    console = Console(file=io.StringIO(), force_terminal=True, width=120, record=True)
+    with ensemble.runner._ProgressBar(4, 1, True, console=console) as bar:
+        bar.advance(True)
+        time.sleep(0.1)
+        bar.advance(False)
+        bar._bar.refresh()
+        text = console.export_text(clear=False)
+    assert "2 done, 1 failed of 4 (1 from an earlier run)" in text
+    assert re.search(r"of 4 \(1 from an earlier run\) \d+:\d\d:\d\d", text), text  # the time left, once rates exist
     assert (bar.done, bar.failed) == (2, 1)
 
 

@@ -210,6 +210,13 @@ def threads() -> int:
     return _THREADS
 
 
+def one_thread_for_this_process() -> None:
+    """Free bodies on one thread from now on in this process: a worker of a process pool, whose siblings share the
+    cores (``tumble.ensemble``'s pool starts each worker with it)."""
+    global _THREADS
+    _THREADS = 1
+
+
 @contextlib.contextmanager
 def using_threads(count: int):
     """Run free bodies on ``count`` threads (1 to one per core) inside the block, then as before: the benchmarks

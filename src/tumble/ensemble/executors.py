@@ -11,6 +11,7 @@ from concurrent.futures import Executor, ProcessPoolExecutor
 from contextlib import contextmanager
 
 from .._validate import as_count
+from ..dynamics.integrate import one_thread_for_this_process
 
 __all__ = ["executor_for", "dask_client", "CONNECT_TIMEOUT"]
 
@@ -52,8 +53,9 @@ def executor_for(executor, workers, jobs: int, build, summary):
     """The executor to submit ``jobs`` members to, shut down after the block if this made it.
 
     ``executor``: None (a process pool of ``workers`` processes, default one per core, started fresh: nothing of
-    this process's threads or locks is inherited), a ``concurrent.futures.Executor``, a ``distributed.Client`` (its
-    ``get_executor()``), or a Dask scheduler's address (a client is opened and closed again)."""
+    this process's threads or locks is inherited; each steps its free bodies on one thread), a
+    ``concurrent.futures.Executor``, a ``distributed.Client`` (its ``get_executor()``), or a Dask scheduler's
+    address (a client is opened and closed again)."""
     if workers is not None:
         workers = as_count("workers", workers)
         if executor is not None:
@@ -62,7 +64,8 @@ def executor_for(executor, workers, jobs: int, build, summary):
         _check_sendable("build", build)
         _check_sendable("summary", summary)
         size = max(1, min(workers or os.cpu_count() or 1, jobs))
-        pool = ProcessPoolExecutor(max_workers=size, mp_context=multiprocessing.get_context("spawn"))
+        pool = ProcessPoolExecutor(max_workers=size, mp_context=multiprocessing.get_context("spawn"),
+                                   initializer=one_thread_for_this_process)  # fmt: skip
         with _shut_down(pool):
             yield pool
     elif isinstance(executor, str):

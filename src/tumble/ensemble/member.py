@@ -6,7 +6,10 @@ A member's files in ``out_dir`` (``NNNNN`` its index):
 - ``member_NNNNN.partial.h5`` while it runs (a worker killed mid-run leaves it: never taken as finished);
 - ``member_NNNNN.h5`` once it is complete: the trajectory, with the member's parameters, the run's settings and its
   summary in the metadata's ``ensemble`` entry (what a rerun reads back instead of running it again);
-- ``member_NNNNN.failed.h5`` when the simulation failed: the frames up to the last good step, and the error.
+- ``member_NNNNN.failed.h5`` when the simulation failed: the frames up to the last good step, and the error;
+- ``member_NNNNN.failed.txt`` when the member failed: its parameters and the traceback.
+
+A member that runs again removes its earlier failure's files first.
 """
 
 from __future__ import annotations
@@ -45,6 +48,10 @@ class MemberTask:
 def member_path(out_dir, index: int, kind: str = "") -> Path:
     """``out_dir/member_NNNNN.h5`` (``kind``: ``""``, ``"partial"`` or ``"failed"``)."""
     return Path(out_dir) / f"member_{index:05d}{'.' + kind if kind else ''}.h5"
+
+
+def _traceback_path(out_dir, index: int) -> Path:
+    return Path(out_dir) / f"member_{index:05d}.failed.txt"
 
 
 def default_summary(world, start_energy: float, start_positions: np.ndarray) -> dict:
@@ -97,28 +104,29 @@ def _built(task: MemberTask):
 def run_member(task: MemberTask) -> dict:
     """Run one member (in a worker): ``{"member", "status": "done" | "failed", "error", "summary", "path",
     "wall_s"}``. An error of the member's own (its build, its simulation, its summary) is reported in the result,
-    never raised, so that it costs no other member; the free bodies step on one thread (the workers share the
-    cores)."""
-    from ..dynamics.integrate import using_threads
+    never raised, so that it costs no other member; its traceback goes to ``member_NNNNN.failed.txt``."""
     from ..recording import record
     from ..trajectory_io import update_h5_metadata
 
     began = time.perf_counter()
     partial = member_path(task.out_dir, task.index, "partial")
     result = {"member": task.index, "status": "failed", "error": None, "summary": {}, "path": None}
+    for stale in (member_path(task.out_dir, task.index, "failed"), _traceback_path(task.out_dir, task.index)):
+        stale.unlink(missing_ok=True)  # an earlier call's failure of this member
     try:
-        with using_threads(1):
-            world, scene, duration, dt, every = _built(task)
-            dynamic = world.model.body_is_dynamic
-            start_energy, start_positions = world.total_energy(), world.state.body_pos[dynamic].copy()
-            record(world, duration, dt, partial, every=every, scene=scene, load=False)
-            summary = default_summary(world, start_energy, start_positions)
-            if task.summary is not None:
-                summary.update(_user_summary(task.summary, world))
+        world, scene, duration, dt, every = _built(task)
+        dynamic = world.model.body_is_dynamic
+        start_energy, start_positions = world.total_energy(), world.state.body_pos[dynamic].copy()
+        record(world, duration, dt, partial, every=every, scene=scene, load=False)
+        summary = default_summary(world, start_energy, start_positions)
+        if task.summary is not None:
+            summary.update(_user_summary(task.summary, world))
         result.update(status="done", summary=summary)
     except Exception as error:  # the member's own failure: reported in its row
         result["error"] = f"{type(error).__name__}: {error}"
-        result["traceback"] = traceback.format_exc(limit=-8)
+        _traceback_path(task.out_dir, task.index).write_text(
+            f"member {task.index}, parameters {task.params}\n\n{traceback.format_exc()}"
+        )
     result["wall_s"] = time.perf_counter() - began
     final = member_path(task.out_dir, task.index, "" if result["status"] == "done" else "failed")
     if partial.exists():

@@ -207,7 +207,7 @@ def _as_frame(table: list[dict]):
 class _ProgressBar:
     """Members done and failed of all, and the time left (rich, on stderr)."""
 
-    def __init__(self, total: int, reused: int, enabled: bool | None) -> None:
+    def __init__(self, total: int, reused: int, enabled: bool | None, console=None) -> None:
         self._bar = None
         self.done, self.failed = reused, 0
         if enabled is None:
@@ -222,7 +222,7 @@ class _ProgressBar:
                 TextColumn("{task.fields[done]} done, {task.fields[failed]} failed of {task.total}"
                            + (f" ({reused} from an earlier run)" if reused else "")),
                 TimeRemainingColumn(),
-                console=Console(stderr=True),
+                console=console or Console(stderr=True),
                 transient=True,
             )  # fmt: skip
             self._task = self._bar.add_task("members", total=total, completed=reused, done=reused, failed=0)
