@@ -496,6 +496,33 @@ def test_sweep_draws_samples_from_a_seed(tmp_path):
     ]
 
 
+@pytest.mark.skipif(not hasattr(signal, "SIGTERM") or sys.platform == "win32", reason="needs POSIX signals")
+@pytest.mark.parametrize(("stop", "status", "said"), [("SIGINT", 130, "interrupted"),
+                                                      ("SIGTERM", 143, "terminated (SIGTERM)")])  # fmt: skip
+def test_a_signal_stops_a_sweep_keeping_the_finished_members(tmp_path, stop, status, said):
+    out = tmp_path / "sweep"
+    args = [sys.executable, "-m", "tumble", "sweep", str(BLOCK), "-p", "materials.surface.friction=0.1:0.9:40",
+            "--duration", "0.5", "-j", "1", "--out", str(out), "--quiet"]  # fmt: skip
+    process = subprocess.Popen(args, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        deadline = time.monotonic() + 300
+        while not (out / "member_00002.h5").exists() and time.monotonic() < deadline and process.poll() is None:
+            time.sleep(0.05)
+        process.send_signal(getattr(signal, stop))
+        stdout, stderr = process.communicate(timeout=60)
+    finally:
+        if process.poll() is None:
+            process.kill()
+    assert process.returncode == status, (stdout, stderr)
+    assert f"tumble: {said}: the members finished so far are kept in" in stderr and "Traceback" not in stderr
+    finished = sorted(p.name for p in out.glob("member_*.h5") if ".partial" not in p.name)
+    assert 3 <= len(finished) < 40
+    assert all(Trajectory.load(out / name).metadata["status"] == "complete" for name in finished)
+    again = tumble_cli(*args[3:])
+    assert again.returncode == 0, again.stderr
+    assert f"40 members, 40 done, 0 failed ({len(finished)} from an earlier run)" in again.stdout
+
+
 def test_sweep_refuses_bad_input_and_reports_failed_members(tmp_path):
     blocker = tmp_path / "file"
     blocker.write_text("")

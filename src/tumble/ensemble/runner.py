@@ -83,6 +83,18 @@ def _reused_row(entry: dict, out: Path, index: int) -> dict:
             "path": str(member_path(out, index))}  # fmt: skip
 
 
+def _row_of(future, index: int) -> dict:
+    """The row a finished future gives: the member's result, or a row saying that its worker was lost."""
+    try:
+        row = future.result()
+    except KeyboardInterrupt:
+        raise
+    except BaseException as error:  # the worker, not the member: killed, cancelled, unpicklable
+        row = _lost_row(index, error)
+    row["reused"] = False
+    return row
+
+
 def _lost_row(index: int, error: BaseException) -> dict:
     what = "cancelled" if isinstance(error, CancelledError) else f"{type(error).__name__}: {error}"
     return {"member": index, "status": "failed", "error": f"its worker was lost ({what})", "summary": {},
@@ -153,16 +165,14 @@ def run(build, params, duration: float | None = None, dt: float | None = None, o
             _ProgressBar(len(tasks), len(tasks) - len(todo), progress) as bar,
         ):
             futures = {pool.submit(run_member, task): task.index for task in todo}
-            for future in as_completed(futures):
-                try:
-                    row = future.result()
-                except BaseException as error:  # the worker, not the member: killed, cancelled, unpicklable
-                    if isinstance(error, KeyboardInterrupt):
-                        raise
-                    row = _lost_row(futures[future], error)
-                row["reused"] = False
-                rows[row["member"]] = row
-                bar.advance(row["status"] == "done")
+            try:
+                for future in as_completed(futures):
+                    rows[futures[future]] = row = _row_of(future, futures[future])
+                    bar.advance(row["status"] == "done")
+            except BaseException:  # Ctrl-C, SIGTERM: members not started are dropped (running ones end themselves)
+                for future in futures:
+                    future.cancel()
+                raise
     table = _table(members, rows)
     _write_csv(out / RESULTS_FILE, table)
     return _as_frame(table)
