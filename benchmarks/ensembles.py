@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import logging
 import math
+import os
 import tempfile
 import time
 from dataclasses import dataclass
@@ -35,11 +36,12 @@ class EnsembleSizes:
     gravities: int = 8
     duration: float = 4.0
     workers: tuple = (1, 2)
+    scaling_members: tuple = (16, 64, 256)  # the local pool on every core: the cost per member should be flat
     repeat: int = 2
 
 
 FULL = EnsembleSizes()
-QUICK = EnsembleSizes(frictions=2, gravities=2, duration=0.1, repeat=1)
+QUICK = EnsembleSizes(frictions=2, gravities=2, duration=0.1, scaling_members=(2, 4), repeat=1)
 SCENE = "box_pile"
 
 
@@ -118,6 +120,21 @@ def bench_ensemble(sizes: EnsembleSizes = FULL) -> list[dict]:
         if 1 in timings and 2 in timings:
             timings[2]["efficiency"] = timings[1]["seconds"] / (2 * timings[2]["seconds"])
             show_row({"executor": timings[2]["executor"], "efficiency": timings[2]["efficiency"]})
+    return rows + _scaling(sizes, path)
+
+
+def _scaling(sizes: EnsembleSizes, path) -> list[dict]:
+    """Random members (one seed) of growing count on the local pool with a worker per core: seconds per member."""
+    rows = []
+    for count in sizes.scaling_members:
+        members = ensemble.sample(count, seed=0, uniform={"bodies[0].friction": (0.1, 0.9),
+                                                          "world.gravity[2]": (-9.81, -1.62)})  # fmt: skip
+        seconds = _timed(lambda out, m=members: ensemble.run(path, m, sizes.duration, out_dir=out, progress=False),
+                         sizes.repeat)  # fmt: skip
+        row = {"scene": SCENE, "members": count, "executor": "local pool, scaling", "workers": os.cpu_count() or 1,
+               "seconds": seconds, "members_per_s": count / seconds, "s_per_member": seconds / count}  # fmt: skip
+        rows.append(row)
+        show_row(row)
     return rows
 
 

@@ -283,6 +283,22 @@ def test_progress_bar_through_the_recorder_callback(folder, tmp_path):
     assert len(trajectory) == 61 and trajectory.metadata["status"] == "complete"
 
 
+def signal_when(command: list[str], ready, stop: str) -> tuple[int, str, str]:
+    """Start ``command``, send it the signal ``stop`` once ``ready()`` (or it ended, or 300 s passed: a cold Numba
+    cache compiles first), and give its exit status, stdout and stderr."""
+    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        deadline = time.monotonic() + 300
+        while not ready() and time.monotonic() < deadline and process.poll() is None:
+            time.sleep(0.05)
+        process.send_signal(getattr(signal, stop))
+        stdout, stderr = process.communicate(timeout=60)
+    finally:
+        if process.poll() is None:
+            process.kill()
+    return process.returncode, stdout, stderr
+
+
 def out_size(path: Path) -> int:
     return path.stat().st_size if path.exists() else 0
 
@@ -294,20 +310,11 @@ def test_a_signal_stops_the_run_and_keeps_the_file_readable(folder, stop, status
     out = folder / f"interrupted_{stop}.h5"  # a file of its own: the other case's would exist from the start
     command = [sys.executable, "-m", "tumble", "run", str(folder / "small.toml"), "--out", str(out),
                "--dt", "1e-4", "--duration", "1000", "--quiet"]  # fmt: skip
-    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    try:
-        deadline = time.monotonic() + 300  # a cold Numba cache compiles first
-        # HDF5's own structures are about 12 kB; the first chunk (2048 frames of three bodies) brings it to about
-        # 900 kB. Waiting for a growth and a second after it found 1 frame where starting up took over a second;
-        # waiting for 100 kB found none, once in a few runs (the file grows before the chunk's frames count).
-        while out_size(out) < 600_000 and time.monotonic() < deadline and process.poll() is None:
-            time.sleep(0.05)
-        process.send_signal(getattr(signal, stop))
-        stdout, stderr = process.communicate(timeout=60)
-    finally:
-        if process.poll() is None:
-            process.kill()
-    assert process.returncode == status, (stdout, stderr)
+    # HDF5's own structures are about 12 kB; the first chunk (2048 frames of three bodies) brings it to about
+    # 900 kB. Waiting for a growth and a second after it found 1 frame where starting up took over a second;
+    # waiting for 100 kB found none, once in a few runs (the file grows before the chunk's frames count).
+    returncode, stdout, stderr = signal_when(command, lambda: out_size(out) >= 600_000, stop)
+    assert returncode == status, (stdout, stderr)
     assert said in stderr and "status 'interrupted'" in stderr and "Traceback" not in stderr
     trajectory = Trajectory.load(out)
     assert trajectory.metadata["status"] == "interrupted"
@@ -503,17 +510,8 @@ def test_a_signal_stops_a_sweep_keeping_the_finished_members(tmp_path, stop, sta
     out = tmp_path / "sweep"
     args = [sys.executable, "-m", "tumble", "sweep", str(BLOCK), "-p", "materials.surface.friction=0.1:0.9:40",
             "--duration", "0.5", "-j", "1", "--out", str(out), "--quiet"]  # fmt: skip
-    process = subprocess.Popen(args, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    try:
-        deadline = time.monotonic() + 300
-        while not (out / "member_00002.h5").exists() and time.monotonic() < deadline and process.poll() is None:
-            time.sleep(0.05)
-        process.send_signal(getattr(signal, stop))
-        stdout, stderr = process.communicate(timeout=60)
-    finally:
-        if process.poll() is None:
-            process.kill()
-    assert process.returncode == status, (stdout, stderr)
+    returncode, stdout, stderr = signal_when(args, (out / "member_00002.h5").exists, stop)
+    assert returncode == status, (stdout, stderr)
     assert f"tumble: {said}: the members finished so far are kept in" in stderr and "Traceback" not in stderr
     finished = sorted(p.name for p in out.glob("member_*.h5") if ".partial" not in p.name)
     assert 3 <= len(finished) < 40
