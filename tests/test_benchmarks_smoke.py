@@ -320,6 +320,7 @@ def test_envs_rows_for_every_env_with_ratios_to_mujoco():
         assert all("x_mujoco_vec4" in r for r in ours if r["env"] == "tumble/DoublePendulum" and r["kind"] == "vector")
 
 
+@pytest.mark.slow  # 20 s: four process pools and two Dask clusters start
 def test_ensemble_rows_for_the_pool_and_dask_with_their_efficiency():
     from benchmarks import ensembles
 

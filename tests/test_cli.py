@@ -504,8 +504,10 @@ def test_sweep_draws_samples_from_a_seed(tmp_path):
 
 
 @pytest.mark.skipif(not hasattr(signal, "SIGTERM") or sys.platform == "win32", reason="needs POSIX signals")
-@pytest.mark.parametrize(("stop", "status", "said"), [("SIGINT", 130, "interrupted"),
-                                                      ("SIGTERM", 143, "terminated (SIGTERM)")])  # fmt: skip
+@pytest.mark.parametrize(("stop", "status", "said"), [
+    pytest.param("SIGINT", 130, "interrupted", marks=pytest.mark.slow),  # the same path as SIGTERM's
+    ("SIGTERM", 143, "terminated (SIGTERM)"),
+])  # fmt: skip
 def test_a_signal_stops_a_sweep_keeping_the_finished_members(tmp_path, stop, status, said):
     out = tmp_path / "sweep"
     args = [sys.executable, "-m", "tumble", "sweep", str(BLOCK), "-p", "materials.surface.friction=0.1:0.9:40",

@@ -343,9 +343,11 @@ def test_bad_arguments_are_named(tmp_path, kwargs, error, match):
     if callable(kwargs.get("build")):
         arguments["params"] = [{"friction": 0.3, "gravity": -9.81}]
     arguments.update(kwargs)
+    out = tmp_path / "out"
+    arguments["out_dir"] = out
     with pytest.raises(error, match=match):
         ensemble.run(**arguments)
-    assert not any(p.suffix == ".h5" for p in tmp_path.iterdir())
+    assert not out.exists()  # refused before anything is made
 
 
 @runs_members

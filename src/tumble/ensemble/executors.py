@@ -10,10 +10,9 @@ import sys
 from concurrent.futures import Executor, ProcessPoolExecutor
 from contextlib import contextmanager
 
-from .._validate import as_count
 from ..dynamics.integrate import one_thread_for_this_process
 
-__all__ = ["executor_for", "dask_client", "CONNECT_TIMEOUT"]
+__all__ = ["check_executor", "executor_for", "dask_client", "CONNECT_TIMEOUT"]
 
 CONNECT_TIMEOUT = 10.0  # [s] to reach a Dask scheduler given by its address
 
@@ -48,21 +47,27 @@ def dask_client(address: str, name: str = "executor"):
                          f"{error}") from None  # fmt: skip
 
 
+def check_executor(executor, build, summary) -> None:
+    """Refuse, before anything runs, an executor of no known kind, and functions the local pool cannot send."""
+    if executor is None:
+        _check_sendable("build", build)
+        _check_sendable("summary", summary)
+    elif not (isinstance(executor, (str, Executor)) or hasattr(executor, "get_executor")
+              or callable(getattr(executor, "submit", None))):  # fmt: skip
+        raise TypeError(f"executor must be None (a local process pool), a concurrent.futures.Executor, a "
+                        f"distributed.Client or a Dask scheduler's address, got {executor!r}")  # fmt: skip
+
+
 @contextmanager
-def executor_for(executor, workers, jobs: int, build, summary):
-    """The executor to submit ``jobs`` members to, shut down after the block if this made it.
+def executor_for(executor, workers: int | None, jobs: int):
+    """The executor to submit ``jobs`` members to (checked by :func:`check_executor`), shut down after the block if
+    this made it.
 
     ``executor``: None (a process pool of ``workers`` processes, default one per core, started fresh: nothing of
     this process's threads or locks is inherited; each steps its free bodies on one thread), a
     ``concurrent.futures.Executor``, a ``distributed.Client`` (its ``get_executor()``), or a Dask scheduler's
     address (a client is opened and closed again)."""
-    if workers is not None:
-        workers = as_count("workers", workers)
-        if executor is not None:
-            raise ValueError(f"workers={workers} sizes the local process pool; the executor given sizes itself")
     if executor is None:
-        _check_sendable("build", build)
-        _check_sendable("summary", summary)
         size = max(1, min(workers or os.cpu_count() or 1, jobs))
         pool = ProcessPoolExecutor(max_workers=size, mp_context=multiprocessing.get_context("spawn"),
                                    initializer=one_thread_for_this_process)  # fmt: skip
@@ -76,11 +81,8 @@ def executor_for(executor, workers, jobs: int, build, summary):
             client.close()
     elif hasattr(executor, "get_executor") and not isinstance(executor, Executor):
         yield executor.get_executor()
-    elif isinstance(executor, Executor) or callable(getattr(executor, "submit", None)):
-        yield executor
     else:
-        raise TypeError(f"executor must be None (a local process pool), a concurrent.futures.Executor, a "
-                        f"distributed.Client or a Dask scheduler's address, got {executor!r}")  # fmt: skip
+        yield executor
 
 
 @contextmanager

@@ -4,6 +4,7 @@ the table."""
 from __future__ import annotations
 
 import csv
+import json
 import math
 import os
 import sys
@@ -12,7 +13,7 @@ from concurrent.futures import CancelledError, as_completed
 from pathlib import Path
 
 from .._validate import as_count, as_float
-from .executors import executor_for
+from .executors import check_executor, executor_for
 from .member import MemberTask, finished_entry, member_path, run_member
 from .params import as_members
 
@@ -141,6 +142,11 @@ def run(build, params, duration: float | None = None, dt: float | None = None, o
         raise ValueError("duration and dt: give both when build is a function (only a scene file has its own)")
     if summary is not None and not callable(summary):
         raise TypeError(f"summary must be a function of the world giving a dict, or None, got {summary!r}")
+    if workers is not None:
+        workers = as_count("workers", workers)
+        if executor is not None:
+            raise ValueError(f"workers={workers} sizes the local process pool; the executor given sizes itself")
+    check_executor(executor, build, summary)
     if out_dir is None:
         raise ValueError("out_dir: give the folder the members' trajectories go to")
     out = _writable(out_dir)
@@ -161,7 +167,7 @@ def run(build, params, duration: float | None = None, dt: float | None = None, o
     todo = [task for task in tasks if rows[task.index] is None]
     if todo:
         with (
-            executor_for(executor, workers, len(todo), build, summary) as pool,
+            executor_for(executor, workers, len(todo)) as pool,
             _ProgressBar(len(tasks), len(tasks) - len(todo), progress) as bar,
         ):
             futures = {pool.submit(run_member, task): task.index for task in todo}
@@ -179,8 +185,7 @@ def run(build, params, duration: float | None = None, dt: float | None = None, o
 
 
 def _as_json(value):
-    import json
-
+    """``value`` as a file's metadata gives it back (tuples as lists)."""
     return json.loads(json.dumps(value))
 
 
