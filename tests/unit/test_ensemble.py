@@ -165,6 +165,22 @@ def test_local_pool_equals_a_serial_loop_and_coulombs_law(tmp_path):
 
 
 @runs_members
+def test_coulombs_law_holds_at_every_step_size_to_the_first_substeps_slide(tmp_path):
+    """The step is one more place to sweep: at 60 Hz, 240 Hz and 1 kHz (8 substeps each) the block lands within
+    v h / 2 of Coulomb's distance, h the substep (friction takes hold over the first substep), and closer in
+    proportion to the step."""
+    members = ensemble.grid({"world.dt": [1 / 60, 1 / 240, 1 / 1000], FRICTION: [0.3, 0.6], GRAVITY: [-9.81, -3.71]})
+    table = _rows(ensemble.run(BLOCK, members, DURATION, None, tmp_path, executor=ThreadPoolExecutor(2)))
+    worst = {}
+    for row in table:
+        dt = row["world.dt"]
+        error = abs(row["max_displacement"] - _slid(row[FRICTION], -row[GRAVITY], DURATION))
+        assert error <= SPEED * (dt / 8) / 2 + 1e-5, (row, error)
+        worst[dt] = max(worst.get(dt, 0.0), error)
+    assert worst[1 / 240] < worst[1 / 60] / 3.5 and worst[1 / 1000] < worst[1 / 240] / 3.5  # first order
+
+
+@runs_members
 def test_a_function_building_worlds_runs_as_the_same_scene(tmp_path):
     members = [{"friction": m[FRICTION], "gravity": m[GRAVITY]} for m in MEMBERS]
     table = _rows(ensemble.run(block_world, members, DURATION, DT, tmp_path, workers=1, record_every=4,
