@@ -188,11 +188,16 @@ def test_the_double_pendulums_bodies_are_the_mujoco_models():
     ]
 
 
-def test_the_quadrotor_hovers_at_the_speeds_that_carry_its_weight_and_falls_without_them():
+def _hovering_quadrotor():
+    """The quadrotor's task and the action (every rotor alike) whose speed carries its weight: kt ω² = m g / 4."""
     task = TASKS["QuadrotorHover"]()
     p = task.params
     hover = math.sqrt(p["mass"] * 9.81 / (4 * p["k_thrust"]))
-    action = 2 * (hover - p["speed_min"]) / (p["speed_max"] - p["speed_min"]) - 1
+    return task, 2 * (hover - p["speed_min"]) / (p["speed_max"] - p["speed_min"]) - 1
+
+
+def test_the_quadrotor_hovers_at_the_speeds_that_carry_its_weight_and_falls_without_them():
+    task, action = _hovering_quadrotor()
     env = make_env("QuadrotorHover")
     env.reset(seed=0)
     start = np.array([0.1, -0.2, 0.3, 1.0, 0.0, 0.0, 0.0])
@@ -245,15 +250,13 @@ def test_a_tilted_quadrotors_thrust_pushes_along_its_body_z_axis():
     """Tilted 30° about x with every rotor at the hover speed: the thrust 4 kt ω² along the body z axis,
     (0, -sin 30°, cos 30°) in the world, plus gravity, accelerates it from rest; RK4 integrates the constant
     acceleration exactly."""
-    task = TASKS["QuadrotorHover"]()
-    p = task.params
-    hover = math.sqrt(p["mass"] * 9.81 / (4 * p["k_thrust"]))
-    action = 2 * (hover - p["speed_min"]) / (p["speed_max"] - p["speed_min"]) - 1
+    task, action = _hovering_quadrotor()
     env = make_env("QuadrotorHover")
     env.reset(seed=0)
     tilt = math.radians(30.0)
     env.set_state(np.array([0.0, 0.0, 0.0, math.cos(tilt / 2), math.sin(tilt / 2), 0.0, 0.0]), np.zeros(6))
     env.step(np.full(4, action))
+    p = task.params
     thrust = 4 * p["k_thrust"] * task.rotor_speeds(np.full((1, 4), action))[0, 0] ** 2
     expected = thrust / p["mass"] * np.array([0.0, -math.sin(tilt), math.cos(tilt)]) + (0.0, 0.0, -9.81)
     np.testing.assert_allclose(env.state[1][:3], expected * 0.01, atol=1e-12)
