@@ -158,7 +158,8 @@ def _print_table(console, args, rows: list[dict], places: list[str]) -> None:
     reused = sum(bool(row["reused"]) for row in rows)
     title = (f"{args.scene}: {len(rows)} members, {len(rows) - failed} done, {failed} failed"
              + (f" ({reused} from an earlier run)" if reused else ""))  # fmt: skip
-    table = Table(title=_text(title), title_justify="left")
+    console.print(_text(title), soft_wrap=True)  # one line, not a title wrapped to the table's width
+    table = Table()
     columns = ["member", *places, "status", *_SHOWN_SUMMARY, "wall_s"]
     for name in columns:
         table.add_column(_text(name), justify="left" if name == "status" else "right")
@@ -171,4 +172,4 @@ def _print_table(console, args, rows: list[dict], places: list[str]) -> None:
         table.add_row(*(_text(cell) for cell in cells))
     console.print(table)
     more = f"{len(rows) - SHOWN_ROWS} more rows: " if len(rows) > SHOWN_ROWS else ""
-    console.print(_text(f"{more}every row in {args.out}/{RESULTS_FILE}"))
+    console.print(_text(f"{more}every row in {args.out}/{RESULTS_FILE}"), soft_wrap=True)

@@ -75,3 +75,23 @@ def test_an_unreachable_scheduler_is_named_as_the_option(tmp_path, monkeypatch, 
 def test_the_same_place_twice_is_refused(tmp_path, capsys):
     status = cli.main(["sweep", str(BLOCK), "-p", "world.dt=0.01", "-p", "world.dt=0.02", "--out", str(tmp_path)])
     assert status == 2 and "--param: world.dt is given twice" in capsys.readouterr().err
+
+
+def test_the_summary_line_is_one_line_however_long_the_scene_path():
+    # A title on the table wrapped at the table's width: CI's checkout path broke "(6 from an earlier run)" in two.
+    import argparse
+    import io
+
+    from rich.console import Console
+
+    from tumble.cli_sweep import _print_table
+
+    scene = "/a/checkout/far/down/" + "deep/" * 30 + "sliding_block.toml"
+    args = argparse.Namespace(scene=scene, out="/tmp/" + "sweep" * 30)
+    rows = [{"member": k, "bodies[0].friction": 0.1 * k, "status": "done", "reused": k < 2, "wall_s": 0.5}
+            for k in range(3)]  # fmt: skip
+    printed = io.StringIO()
+    _print_table(Console(file=printed, width=160), args, rows, ["bodies[0].friction"])
+    lines = printed.getvalue().splitlines()
+    assert f"{scene}: 3 members, 3 done, 0 failed (2 from an earlier run)" in lines
+    assert f"every row in {args.out}/results.csv" in lines
