@@ -7,13 +7,12 @@ import os
 import numpy as np
 import pytest
 
+from compiled import compiled_only
 from tumble import SimulationError
 from tumble.articulation import Articulation, ArticulationBatch, Ball, Free, Prismatic, Revolute
 from tumble.dynamics.integrate import using_threads
 from tumble.mass import MassProperties
 from tumble.shapes import Box
-
-COMPILED = os.environ.get("NUMBA_DISABLE_JIT", "0") != "1"
 
 
 def cart_pole() -> Articulation:
@@ -83,7 +82,7 @@ def test_every_copy_moves_bit_for_bit_as_the_articulation_alone(build, integrato
     assert np.ptp(batch.q[:, -1]) > 0.0  # the copies differ
 
 
-@pytest.mark.skipif(not COMPILED, reason="two threads only matter compiled")
+@compiled_only("two threads only matter compiled")
 def test_two_threads_give_the_bits_of_one():
     art = ball_chain()
     results = []

@@ -9,14 +9,14 @@ import numpy as np
 import pytest
 
 import tumble
+from compiled import compiled_only
 from tumble import Batch
 from tumble import mass as tm
 from tumble.dynamics import integrate
 
 two_cores = pytest.mark.skipif((os.cpu_count() or 1) < 2, reason="needs two cores")
-compiled = pytest.mark.skipif(os.environ.get("NUMBA_DISABLE_JIT") == "1", reason="a minute as plain Python")
+compiled = compiled_only("a minute as plain Python")
 THREADS = [1, pytest.param(2, marks=two_cores)]
-COMPILED_THREADS = [1, pytest.param(2, marks=[two_cores, compiled])]  # the threads' path again, compiled only
 BODY_FIELDS = ("body_pos", "body_quat", "body_linvel", "body_angmom")
 
 
@@ -88,7 +88,8 @@ def test_free_copies_equal_separate_worlds_bit_for_bit(integrator, threads, monk
     _assert_copies_equal(batch, worlds)
 
 
-@pytest.mark.parametrize("threads", COMPILED_THREADS)
+@compiled  # the other tests' piles run the batch's contact kernels as plain Python
+@pytest.mark.parametrize("threads", THREADS)
 def test_copies_with_contacts_equal_separate_worlds_bit_for_bit(threads):
     worlds = [_pile(k) for k in range(5)]  # two blocks (one per core) of two and three copies
     batch = _batch_of(worlds)
@@ -103,7 +104,8 @@ def test_copies_with_contacts_equal_separate_worlds_bit_for_bit(threads):
     assert not np.array_equal(batch.state.body_pos[0], batch.state.body_pos[4])  # the copies did differ
 
 
-@pytest.mark.parametrize("threads", COMPILED_THREADS)
+@compiled  # the reset test's chains run the batch's joint kernels as plain Python
+@pytest.mark.parametrize("threads", THREADS)
 def test_jointed_copies_equal_separate_worlds_bit_for_bit(threads):
     worlds = [_chain(k) for k in range(3)]
     batch = _batch_of(worlds)

@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 import tumble
+from compiled import compiled_only
 from tumble import scenes
 from tumble.rotation import quat_from_axis_angle, quat_from_rotvec
 
@@ -82,6 +83,7 @@ def test_box_pile_resumes_bit_identically(tmp_path):
     assert [b.name for b in loaded.bodies] == ["ground"] + [f"box{k}" for k in range(64)]
 
 
+@compiled_only("20 s as plain Python; the fresh process's test resumes the same machine")
 def test_jointed_machine_resumes_bit_identically(tmp_path):
     loaded = _resume_matches(_machine, 45, 45, tmp_path)
     reference = _machine()

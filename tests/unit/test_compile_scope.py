@@ -13,20 +13,18 @@
 from __future__ import annotations
 
 import json
-import os
 import subprocess
 import sys
 
 import numpy as np
-import pytest
 
+from compiled import compiled_only
 from tumble import math3d, scenes
 from tumble._jit import kernel
 from tumble.geometry import narrow_phase
 from tumble.shapes import ShapeType
 
-COMPILED = os.environ.get("NUMBA_DISABLE_JIT", "0") != "1"
-needs_jit = pytest.mark.skipif(not COMPILED, reason="compiled code only (NUMBA_DISABLE_JIT=1)")
+needs_jit = compiled_only("about compiled code")
 
 _PROBE = """
 import json, tumble

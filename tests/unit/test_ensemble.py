@@ -17,6 +17,7 @@ import numpy as np
 import pytest
 
 import tumble
+from compiled import compiled_only
 from tumble import ensemble, scene_file
 from tumble.dynamics import integrate
 from tumble.ensemble import executors
@@ -93,8 +94,7 @@ MEMBERS = ensemble.grid({FRICTION: [0.3, 0.6], GRAVITY: [-9.81, -3.71]})
 
 # The ensemble has no kernels of its own: its members step through those the other tests also run as plain Python,
 # where these runs would take a minute and a half.
-runs_members = pytest.mark.skipif(os.environ.get("NUMBA_DISABLE_JIT") == "1", reason="members step for minutes as "
-                                  "plain Python")  # fmt: skip
+runs_members = compiled_only("members step for minutes as plain Python")
 
 
 # --- grid and sample ------------------------------------------------------------------------------------------

@@ -11,6 +11,7 @@ import sys
 import numpy as np
 import pytest
 
+from compiled import compiled_only
 from tumble import scene_file
 
 PENDULUM = """<mujoco model="swing">
@@ -146,6 +147,7 @@ def tumble_cli(*args, cwd):
                           cwd=cwd, timeout=300)  # fmt: skip
 
 
+@compiled_only("five commands in fresh processes: 10 s as plain Python, stepping what the other tests step")
 def test_tumble_run_and_info_take_a_model_file(folder):
     info = tumble_cli("info", "parts/swing.xml", cwd=folder)
     assert info.returncode == 0, info.stderr

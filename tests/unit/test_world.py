@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 import tumble
+from compiled import COMPILED, compiled_only
 from tumble import mass as tm
 from tumble import scenes
 from tumble.dynamics import integrate
@@ -151,10 +152,11 @@ def _scene(integrator="auto"):
 
 @pytest.mark.parametrize("integrator", ["euler", "symplectic", "rk4", "midpoint"])
 def test_runs_are_bit_identical_and_simulate_equals_repeated_steps(integrator):
+    steps = 1000 if COMPILED else 50  # a minute as plain Python, where 50 steps reach the same lines
     a, b, c = _scene(integrator), _scene(integrator), _scene(integrator)
-    a.simulate(1.0, 1e-3)
-    b.simulate(1.0, 1e-3)
-    for _ in range(1000):
+    a.simulate(steps * 1e-3, 1e-3)
+    b.simulate(steps * 1e-3, 1e-3)
+    for _ in range(steps):
         c.step(1e-3)
     assert a.state.digest() == b.state.digest() == c.state.digest()
 
@@ -163,6 +165,7 @@ two_cores = pytest.mark.skipif((os.cpu_count() or 1) < 2, reason="needs two core
 
 
 @two_cores
+@compiled_only("plain Python runs a parallel loop on one thread")
 def test_threaded_and_single_threaded_runs_agree_bit_for_bit(monkeypatch):
     threaded, single = _scene(), _scene()
     monkeypatch.setattr(integrate, "PARALLEL_MIN_WORK", 1)
@@ -188,7 +191,7 @@ def free_spheres():
 
 
 @two_cores
-@pytest.mark.skipif(os.environ.get("NUMBA_DISABLE_JIT") == "1", reason="minutes as plain Python")
+@compiled_only("minutes as plain Python")
 @pytest.mark.parametrize("integrator", ["auto", "symplectic"])
 def test_4096_free_bodies_and_a_pile_give_the_same_bits_on_one_thread_and_two(integrator, free_spheres):
     """4096 bodies for 60 steps is above the size at which the free bodies split across threads; the pile (contacts)
