@@ -89,16 +89,11 @@ def test_imu_bias_walks_by_its_density_times_root_dt():
 def test_pose_noise_has_the_standard_deviation_asked_for():
     world, body = box_world(gravity=(0, 0, 0), position=(1, 2, 3), orientation=quat_from_axis_angle((0, 0, 1), 1.0))
     pose = world.add_sensor(Pose(body, position_noise=0.002, orientation_noise=0.01, seed=11))
-    positions, turns = [], []
-
-    def collect(w, t):
-        p, q = pose.read()
-        positions.append(p)
-        turns.append(quat_to_rotvec(quat_multiply(q, quat_conjugate(body.orientation))))
-
-    world.add_controller(collect)
+    readings = []
+    world.add_controller(lambda w, t: readings.append(pose.read()))
     world.simulate(10.0, 1e-3)
-    positions, turns = np.array(positions[1:]), np.array(turns[1:])
+    positions = np.array([p for p, _ in readings[1:]])
+    turns = quat_to_rotvec(quat_multiply(np.array([q for _, q in readings[1:]]), quat_conjugate(body.orientation)))
     np.testing.assert_allclose(positions.mean(axis=0), (1, 2, 3), atol=4 * 0.002 / math.sqrt(len(positions)))
     np.testing.assert_allclose(positions.std(axis=0), 0.002, rtol=0.03)
     np.testing.assert_allclose(turns.std(axis=0), 0.01, rtol=0.03)
