@@ -81,7 +81,10 @@ def test_two_vehicles_pass_without_touching():
     assert speeds.max() > 2.0  # at full speed as they pass
 
 
-@pytest.mark.parametrize("name", QUADROTOR_SCENES)
+# 10 s each: make test runs the two vehicles with their sensors through the command; make test-slow every scene
+# (the tests above fly each of them).
+@pytest.mark.parametrize("name", [n if n == "quadrotor_passing" else pytest.param(n, marks=pytest.mark.slow)
+                                  for n in QUADROTOR_SCENES])  # fmt: skip
 def test_every_quadrotor_scene_runs_from_the_command_line_with_plots_and_replay(name, tmp_path):
     out = tmp_path / name
     command = [sys.executable, "-m", "tumble", "run", str(scene_file.shipped_scene(name)), "--quiet", "--duration",

@@ -19,7 +19,7 @@ def autocorrelation(x: np.ndarray, lags: np.ndarray) -> np.ndarray:
     return np.array([np.dot(x[: n - lag], x[lag:]) / (n - lag) for lag in lags]) / x.var()
 
 
-@pytest.mark.parametrize("dt", [1e-3, 1e-2])
+@pytest.mark.parametrize("dt", [pytest.param(1e-3, marks=pytest.mark.slow), 1e-2])  # 1e-3: a million steps, 20 s
 def test_dryden_gusts_have_the_intensity_and_correlation_time_of_the_spectrum(dt):
     """σ = (1, 0.7, 0.5) m/s, L = 0.5 m carried at 5 m/s (T = 0.1 s), 1000 s: the standard deviations, and the
     correlation times fitted to e^(−τ/T) (u) and (1 − τ/2T) e^(−τ/T) (v, w), within 10 % (measured within 4 %)."""
