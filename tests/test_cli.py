@@ -92,6 +92,25 @@ def tumble_cli(*args, cwd=None, timeout=300, env=None) -> subprocess.CompletedPr
     )
 
 
+@pytest.fixture
+def tumble_here(capsys):
+    """``tumble ARGS`` called in this process (``cli.main``, argparse's exit caught), for the refusals: the status
+    and what it prints, as :func:`tumble_cli` gives them, without the 1.5 s start of a fresh process (an uncaught
+    error fails the test). The refusals in fresh processes are in test_bad_arguments_are_exit_2."""
+    from tumble import cli
+
+    def call(*args) -> subprocess.CompletedProcess:
+        capsys.readouterr()
+        try:
+            status = cli.main([str(arg) for arg in args])
+        except SystemExit as exit:
+            status = exit.code
+        out, err = capsys.readouterr()
+        return subprocess.CompletedProcess(args, status, out, err)
+
+    return call
+
+
 def assert_clean_failure(result, status: int, *fragments: str) -> None:
     """Exit status ``status``, each fragment in stderr, and no traceback."""
     assert result.returncode == status, (result.returncode, result.stdout, result.stderr)
@@ -171,7 +190,7 @@ def test_view_without_a_scene_draws_balls(folder):
     assert {s["kind"] for s in data["shapes"]} == {"sphere", "box", "capsule"} and len(data["planes"]) == 1
 
 
-def test_plot(flagship_run, folder):
+def test_plot(flagship_run, folder, tumble_here):
     out = folder / "plots"
     result = tumble_cli("plot", flagship_run["h5"], "--what", "energy,momentum,omega,paths", "-o", out,
                         "--bodies", "wrecking_ball,link9")  # fmt: skip
@@ -182,8 +201,8 @@ def test_plot(flagship_run, folder):
     assert tumble_cli("plot", flagship_run["h5"], "-o", single).returncode == 0
     assert single.read_text().lstrip().startswith("<?xml")
 
-    assert_clean_failure(tumble_cli("plot", flagship_run["h5"], "--what", "energy,spin"), 2, "--what")
-    assert_clean_failure(tumble_cli("plot", flagship_run["h5"], "--what", "omega", "--bodies", "nobody", "-o", out),
+    assert_clean_failure(tumble_here("plot", flagship_run["h5"], "--what", "energy,spin"), 2, "--what")
+    assert_clean_failure(tumble_here("plot", flagship_run["h5"], "--what", "omega", "--bodies", "nobody", "-o", out),
                          2, "nobody")  # fmt: skip
 
 
@@ -241,25 +260,27 @@ BAD_SCENES = {
 
 
 @pytest.mark.parametrize("case", sorted(BAD_SCENES))
-def test_bad_scene_is_exit_2_with_file_and_place(case, tmp_path):
+def test_bad_scene_is_exit_2_with_file_and_place(case, tmp_path, tumble_here):
     text, place = BAD_SCENES[case]
     path = tmp_path / f"{case}.toml"
     path.write_text(text)
     command = "info" if case in ("syntax", "unknown_key") else "run"
-    assert_clean_failure(tumble_cli(command, path, "--quiet") if command == "run" else tumble_cli(command, path),
+    assert_clean_failure(tumble_here(command, path, "--quiet") if command == "run" else tumble_here(command, path),
                          2, f"{case}.toml", place)  # fmt: skip
 
 
-def test_bad_arguments_are_exit_2(folder, tmp_path):
+def test_bad_arguments_are_exit_2(folder, tmp_path, tumble_here):
+    # Two in fresh processes: argparse's refusal and one of tumble's own, as a user's shell sees them.
     assert_clean_failure(tumble_cli("run", tmp_path / "nowhere.toml"), 2, "nowhere.toml", "no such scene file")
-    assert_clean_failure(tumble_cli("run", folder / "small.toml", "--dt", "-1"), 2, "--dt", "-1")
-    assert_clean_failure(tumble_cli("run", folder / "small.toml", "--out", tmp_path / "x.csv"), 2, ".h5", ".npz")
-    assert_clean_failure(tumble_cli("run", folder / "small.toml", "--plot", tmp_path / "e.xyz"), 2, "--plot")
-    assert_clean_failure(tumble_cli("view", tmp_path / "none.h5", "-o", tmp_path / "r.html"), 2, "none.h5")
     assert_clean_failure(tumble_cli("frobnicate"), 2, "invalid choice")
+    assert_clean_failure(tumble_here("frobnicate"), 2, "invalid choice")
+    assert_clean_failure(tumble_here("run", folder / "small.toml", "--dt", "-1"), 2, "--dt", "-1")
+    assert_clean_failure(tumble_here("run", folder / "small.toml", "--out", tmp_path / "x.csv"), 2, ".h5", ".npz")
+    assert_clean_failure(tumble_here("run", folder / "small.toml", "--plot", tmp_path / "e.xyz"), 2, "--plot")
+    assert_clean_failure(tumble_here("view", tmp_path / "none.h5", "-o", tmp_path / "r.html"), 2, "none.h5")
     assert not list(tmp_path.iterdir())  # nothing was written
     (folder / "garbage.npz").write_bytes(b"PK\x03\x04 not a zip")
-    assert_clean_failure(tumble_cli("plot", folder / "garbage.npz"), 2, "garbage.npz", "cannot read")
+    assert_clean_failure(tumble_here("plot", folder / "garbage.npz"), 2, "garbage.npz", "cannot read")
 
 
 def test_simulation_error_is_exit_1_and_keeps_what_was_recorded(folder):
@@ -523,27 +544,27 @@ def test_a_signal_stops_a_sweep_keeping_the_finished_members(tmp_path, stop, sta
     assert f"40 members, 40 done, 0 failed ({len(finished)} from an earlier run)" in again.stdout
 
 
-def test_sweep_refuses_bad_input_and_reports_failed_members(tmp_path):
+def test_sweep_refuses_bad_input_and_reports_failed_members(tmp_path, tumble_here):
     blocker = tmp_path / "file"
     blocker.write_text("")
     base = ("sweep", BLOCK, "--duration", "0.2", "-j", "1", "-q")
-    assert_clean_failure(tumble_cli(*base, "-p", "materials.surface.frictoin=0.1,0.2", "--out", tmp_path / "a"), 2,
+    assert_clean_failure(tumble_here(*base, "-p", "materials.surface.frictoin=0.1,0.2", "--out", tmp_path / "a"), 2,
                          "--param: sliding_block.toml: materials.surface.frictoin: unknown key")  # fmt: skip
-    assert_clean_failure(tumble_cli(*base, "-p", "materials.surface.friction=0.1:0.2", "--out", tmp_path / "a"), 2,
+    assert_clean_failure(tumble_here(*base, "-p", "materials.surface.friction=0.1:0.2", "--out", tmp_path / "a"), 2,
                          "a range is LOW:HIGH:N")  # fmt: skip
-    assert_clean_failure(tumble_cli(*base, "-p", "world.dt=0.01", "--out", blocker / "x"), 2,
+    assert_clean_failure(tumble_here(*base, "-p", "world.dt=0.01", "--out", blocker / "x"), 2,
                          "--out", "cannot write there: Not a directory")  # fmt: skip
-    assert_clean_failure(tumble_cli(*base, "-p", "world.dt=0.01", "--out", tmp_path / "b", "--workers", "2",
+    assert_clean_failure(tumble_here(*base, "-p", "world.dt=0.01", "--out", tmp_path / "b", "--workers", "2",
                                     "--scheduler", "tcp://127.0.0.1:1"), 2, "not allowed with argument")  # fmt: skip
     result = tumble_cli(*base, "-p", "world.gravity[2]=-9.81,-1e308", "--out", tmp_path / "c")
     assert result.returncode == 1 and "Traceback" not in result.stderr, result.stderr
     assert "2 members, 1 done, 1 failed" in result.stdout and "SimulationError" in result.stdout
 
 
-def test_batch_refuses_what_it_cannot_step_and_names_it(folder):
-    assert_clean_failure(tumble_cli("batch", folder / "small.toml", "-n", "0"), 2, "-n", "0")
-    assert_clean_failure(tumble_cli("batch", folder / "small.toml"), 2, "-n")
-    assert_clean_failure(tumble_cli("batch", "quadrotor_landing", "-n", "2"), 2, "quadrotor_landing",
+def test_batch_refuses_what_it_cannot_step_and_names_it(folder, tumble_here):
+    assert_clean_failure(tumble_here("batch", folder / "small.toml", "-n", "0"), 2, "-n", "0")
+    assert_clean_failure(tumble_here("batch", folder / "small.toml"), 2, "-n")
+    assert_clean_failure(tumble_here("batch", "quadrotor_landing", "-n", "2"), 2, "quadrotor_landing",
                          "a Batch steps bodies, shapes and joints")  # fmt: skip
     result = tumble_cli("batch", folder / "spinner.toml", "-n", "3", "--quiet")
     assert_clean_failure(result, 1, "simulation failed", "copy 0: body 'spinner'", "step 25")
