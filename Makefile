@@ -50,7 +50,7 @@ BOUNDSCHECK_TESTS := tests/unit/test_gjk.py tests/unit/test_collide_convex.py te
 
 # The tests marked slow (every shipped scene at every rate, the long scenes), then the bounds-checked pass. Numba's
 # cache does not tell a bounds-checked build from a plain one, so that pass compiles into a cache of its own.
-test-slow: $(STAMP)
+test-slow: $(STAMP) $(BROWSER_STAMP)
 	$(PYTEST) -m slow
 	NUMBA_BOUNDSCHECK=1 NUMBA_CACHE_DIR=$(VENV)/numba-boundscheck $(PY) -m pytest -q -p no:cacheprovider \
 		$(BOUNDSCHECK_TESTS)

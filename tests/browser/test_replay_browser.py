@@ -262,6 +262,7 @@ def test_webgl1_with_instanced_arrays_draws_the_uncompressed_page(browser, pile_
     assert page.errors == []
 
 
+@pytest.mark.slow  # 15 s: the pile of 1000 boxes simulated for 10 s first
 def test_thousand_boxes_for_600_frames_fit_the_budget_and_play(browser, tmp_path, artifacts):
     """Issue 5's budget: 1000 bodies x 600 frames under 20 MB, played at >= 30 fps in Chromium on a GPU. Here
     WebGL runs in SwiftShader on the CPU, so the frame rate is recorded (out/test-artifacts/replay_1000x600.json)
