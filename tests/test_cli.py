@@ -96,7 +96,7 @@ def tumble_cli(*args, cwd=None, timeout=300, env=None) -> subprocess.CompletedPr
 def tumble_here(capsys):
     """``tumble ARGS`` called in this process (``cli.main``, argparse's exit caught), for the refusals: the status
     and what it prints, as :func:`tumble_cli` gives them, without the 1.5 s start of a fresh process (an uncaught
-    error fails the test). The refusals in fresh processes are in test_bad_arguments_are_exit_2."""
+    error fails the test). Every command also runs in a fresh process in a test of its own."""
     from tumble import cli
 
     def call(*args) -> subprocess.CompletedProcess:
@@ -219,7 +219,7 @@ def test_info_lists_bodies_joints_and_settings(folder):
     assert re.search(r"[+-]z, [+-]y, [+-]x", crate), crate  # the principal axes of those moments: z, y, x
 
 
-def test_examples_lists_and_copies(tmp_path):
+def test_examples_lists_and_copies(tmp_path, tumble_here):
     result = tumble_cli("examples")
     assert result.returncode == 0, result.stderr
     shipped = scene_file.shipped()
@@ -229,11 +229,11 @@ def test_examples_lists_and_copies(tmp_path):
     words = " ".join(re.sub(r"[│┃]", " ", result.stdout).split())  # the table wraps long descriptions
     assert "wrecking ball" in words
 
-    result = tumble_cli("examples", "--copy", tmp_path / "scenes")
+    result = tumble_here("examples", "--copy", tmp_path / "scenes")
     assert result.returncode == 0, result.stderr
     assert sorted(p.name for p in (tmp_path / "scenes").glob("*.toml")) == sorted(p.name for p in shipped)
     assert len(scene_file.load(tmp_path / "scenes" / "flagship.toml").world.bodies) == 103
-    again = tumble_cli("examples", "--copy", tmp_path / "scenes")  # existing files are kept unless --force
+    again = tumble_here("examples", "--copy", tmp_path / "scenes")  # existing files are kept unless --force
     assert again.returncode == 0 and "kept existing" in again.stderr
 
 
@@ -387,7 +387,7 @@ def test_a_ctrl_c_that_python_drops_is_raised_again_at_the_next_chunk():
     assert signal.getsignal(signal.SIGTERM) is signal.SIG_DFL
 
 
-def test_info_lists_the_first_rows_of_a_big_scene_and_all_with_all(tmp_path):
+def test_info_lists_the_first_rows_of_a_big_scene_and_all_with_all(tmp_path, tumble_here):
     parts = ["[world]\n"]
     parts += [f'[[bodies]]\nname = "b{i}"\nshape = {{ type = "sphere", radius = 0.1 }}\nmass = 1.0\n'
               f"position = [{0.5 * i}, 0, 1]\n" for i in range(130)]  # fmt: skip
@@ -397,13 +397,13 @@ def test_info_lists_the_first_rows_of_a_big_scene_and_all_with_all(tmp_path):
     ]
     scene = tmp_path / "many.toml"
     scene.write_text("\n".join(parts))
-    short = tumble_cli("info", scene)
+    short = tumble_here("info", scene)
     assert short.returncode == 0, short.stderr
     bodies_table = short.stdout.split("joints (")[0]
     assert " b99 " in bodies_table and " b100 " not in bodies_table
     assert "... and 30 more bodies (tumble info --all" in short.stdout
     assert "... and 20 more joints" in short.stdout
-    full = tumble_cli("info", scene, "--all")
+    full = tumble_here("info", scene, "--all")
     assert full.returncode == 0, full.stderr
     assert " b129 " in full.stdout and "more bodies" not in full.stdout and "more joints" not in full.stdout
 
