@@ -31,12 +31,17 @@ $(BROWSER_STAMP): $(STAMP)
 # Python and compiled loops, so two halve the wall time (make test: 556 s -> 274 s, then 178 s -> 115 s).
 TEST_JOBS ?= 2
 PYTEST := $(PY) -m pytest -q -n $(TEST_JOBS)
+# make test gives each process whole files (--dist loadfile): dealt out one by one, both processes compiled the kernels
+# a file needs beyond tumble warmup's and built its module fixtures (a fresh clone's first pass: 486 s -> 320 s, some
+# 15 s of it from tests changed between the two runs).
+# Not make test-slow, whose tests are seven in ten in one file (tests/analytic/test_contact_rates.py).
+BY_FILE := --dist loadfile
 
 # What every change passes before it is submitted (under 8 minutes from a fresh clone): everything but the tests
 # marked slow, then the unit tests again as plain Python (NUMBA_DISABLE_JIT=1).
 test: $(STAMP) $(BROWSER_STAMP)
-	$(PYTEST) -m "not slow"
-	NUMBA_DISABLE_JIT=1 $(PYTEST) tests/unit -m "not slow" -p no:cacheprovider
+	$(PYTEST) $(BY_FILE) -m "not slow"
+	NUMBA_DISABLE_JIT=1 $(PYTEST) $(BY_FILE) tests/unit -m "not slow" -p no:cacheprovider
 
 # The narrow phase, GJK/EPA and contact tests (the contact grid included), and the mixed pile for 12 s at 240 Hz,
 # run again with every array access bounds-checked: an index out of range raises IndexError instead of reading or
