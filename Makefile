@@ -43,15 +43,15 @@ test: $(STAMP) $(BROWSER_STAMP)
 	$(PYTEST) $(BY_FILE) -m "not slow"
 	NUMBA_DISABLE_JIT=1 $(PYTEST) $(BY_FILE) tests/unit -m "not slow" -p no:cacheprovider
 
-# The narrow phase, GJK/EPA and contact tests (the contact grid included), and the mixed pile for 12 s at 240 Hz,
-# run again with every array access bounds-checked: an index out of range raises IndexError instead of reading or
-# writing memory it does not own.
+# The narrow phase, GJK/EPA and contact tests (the contact grid included), the mixed pile for 12 s at 240 Hz, the
+# compiled flights and the sensors, run again with every array access bounds-checked: an index out of range raises
+# IndexError instead of reading or writing memory it does not own.
 BOUNDSCHECK_TESTS := tests/unit/test_gjk.py tests/unit/test_collide_convex.py tests/unit/test_collide_primitives.py \
 	tests/unit/test_broad_phase.py tests/unit/test_contact_api.py tests/unit/test_query_overlap.py \
 	tests/properties/test_convex_properties.py tests/properties/test_collide_properties.py \
 	tests/analytic/test_contact.py tests/analytic/test_contact_rates.py \
 	tests/analytic/test_shipped_scenes.py::test_the_mixed_pile_runs_12_s_at_240_hz_past_its_old_crash \
-	tests/analytic/test_native_flight.py
+	tests/analytic/test_native_flight.py tests/analytic/test_sensors.py
 
 # The tests marked slow (every shipped scene at every rate, the long scenes), then the bounds-checked pass. Numba's
 # cache does not tell a bounds-checked build from a plain one, so that pass compiles into a cache of its own.
