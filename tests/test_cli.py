@@ -149,6 +149,10 @@ def test_run_writes_trajectory_replay_and_plot(flagship_run):
     for row in ("simulated time", "steps", "steps/s", "real-time factor", "energy drift", "contacts", "sleeping"):
         assert row in result.stdout, result.stdout
     assert "30 " in result.stdout  # 0.5 s at dt = 1/60
+    # The digest row is the run's final state, as the same steps give it in this process.
+    loaded = scene_file.load(scene_file.shipped_scene("flagship"))
+    loaded.world.simulate(0.5, loaded.run.dt)
+    assert re.search(rf"state digest\W+{loaded.world.state.digest()[:16]}\W", result.stdout), result.stdout
 
     trajectory = Trajectory.load(flagship_run["h5"])
     assert len(trajectory) == 31 and trajectory.time[-1] == pytest.approx(0.5)

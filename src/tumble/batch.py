@@ -26,6 +26,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from . import portable
 from ._validate import _show, as_array, as_count, as_step, listed
 from .batch_rows import DRIVE_TARGET, copy_impulses, rows_model, splice_contacts, tiled_impulses
 from .dynamics.actuation import ActuatorArrays
@@ -320,7 +321,7 @@ class Batch:
         scale = np.divide(mass, base.body_mass, out=np.ones_like(mass), where=dynamic)
         inertia = base.body_inertia_local * scale[:, :, None, None]
         inv_inertia = np.zeros_like(inertia)
-        inv_inertia[:, dynamic] = np.linalg.inv(inertia[:, dynamic])
+        inv_inertia[:, dynamic] = portable.inverse(inertia[:, dynamic])
         inv_mass = np.divide(1.0, mass, out=np.zeros_like(mass), where=dynamic)
         span = slice(first, last)
         return {"gravity": self._gravity[span], "mass": mass, "inv_mass": inv_mass, "inertia": inertia,

@@ -10,6 +10,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from . import portable
 from .dynamics.joint_solver import JointArrays
 from .geometry.broad_phase import exclusion_table
 from .geometry.packing import pack_geometry
@@ -93,7 +94,7 @@ class ModelBuilder:
         mp = self.rows[index].mass_properties
         if mp is None:
             return 0.0, np.zeros(3), np.zeros((3, 3)), np.zeros((3, 3))
-        return float(mp.mass), np.asarray(mp.com, np.float64), mp.inertia, np.linalg.inv(mp.inertia)
+        return float(mp.mass), np.asarray(mp.com, np.float64), mp.inertia, portable.inverse(mp.inertia)
 
     def add_body(
         self,
@@ -140,7 +141,7 @@ class ModelBuilder:
         inertia = np.array([_ZERO33 if mp is None else mp.inertia for mp in mps], np.float64).reshape(n, 3, 3)
         inv_inertia = np.zeros((n, 3, 3))
         is_dynamic = mass > 0.0
-        inv_inertia[is_dynamic] = np.linalg.inv(inertia[is_dynamic])  # as mass_row inverts one
+        inv_inertia[is_dynamic] = portable.inverse(inertia[is_dynamic])  # as mass_row inverts one
         inv_mass = np.divide(1.0, mass, out=np.zeros(n), where=is_dynamic)
         specs = [(i, s) for i, row in enumerate(self.rows) for s in row.shapes]
         shape_body = np.array([i for i, _ in specs], np.int64)

@@ -311,6 +311,7 @@ def _print_run_summary(console, world, scene_path: Path, *, dt, steps, planned, 
         ("contacts", f"{len(world.contacts())}", "contact points in the last step"),
         ("sleeping bodies", f"{sleeping} / {len(dynamic)}", "dynamic bodies at rest"),
         ("joints", f"{len(world.joints)}", ""),
+        ("state digest", world.state.digest()[:16], "world.state.digest(): equal on every machine for equal inputs"),
     ]
     for quantity, value, note in rows:
         table.add_row(_text(quantity), _text(value), _text(note))

@@ -10,6 +10,7 @@ import numpy as np
 
 from ._validate import as_quaternion, as_rate, as_vector3, finite_result, listed
 from .dynamics.joint_solver import DAMPING, LOWER, MAX_MOTOR, MOTOR_SPEED, TARGET, UPPER, JointKind
+from .portable import dot, matmul, matvec
 from .rotation import quat_rotate, quat_to_matrix
 
 __all__ = ["Body", "Joint"]
@@ -127,14 +128,14 @@ class Body:
         """ω = R I⁻¹ Rᵀ L [rad/s], world frame (the state holds the angular momentum ``L``)."""
         r = self.rotation
         inv_inertia = self._mass()[3]
-        return r @ (inv_inertia @ (r.T @ self._row()[3]))
+        return matvec(r, matvec(inv_inertia, matvec(r.T, self._row()[3])))
 
     @angular_velocity.setter
     def angular_velocity(self, value) -> None:
         value = as_rate("angular_velocity", value)
         self._refuse_static("angular_velocity")
         with np.errstate(over="ignore", invalid="ignore"):
-            momentum = self.inertia_world @ value
+            momentum = matvec(self.inertia_world, value)
         finite_result(momentum, "angular_velocity", value, "gives the angular momentum")
         self._require_dynamic("angular_velocity")
         self._row()[3][:] = momentum
@@ -142,7 +143,7 @@ class Body:
     @property
     def angular_velocity_body(self) -> np.ndarray:
         """ω [rad/s] in the body frame, ``Rᵀ ω``."""
-        return self.rotation.T @ self.angular_velocity
+        return matvec(self.rotation.T, self.angular_velocity)
 
     def point_velocity(self, point) -> np.ndarray:
         """Velocity of the body-fixed point now at world ``point``: ``v + ω × (p − x_com)`` [m/s]."""
@@ -166,7 +167,7 @@ class Body:
     def inertia_world(self) -> np.ndarray:
         """``R I Rᵀ`` [kg m²], about the COM."""
         r = self.rotation
-        return r @ self._mass()[2] @ r.T
+        return matmul(matmul(r, self._mass()[2]), r.T)
 
     @property
     def linear_momentum(self) -> np.ndarray:
@@ -181,7 +182,7 @@ class Body:
     def kinetic_energy(self) -> float:
         """½ m |v|² + ½ ω·L [J]."""
         v = self.velocity
-        return float(0.5 * self.mass * v @ v + 0.5 * self.angular_velocity @ self.angular_momentum)
+        return float(0.5 * self.mass * dot(v, v) + 0.5 * dot(self.angular_velocity, self.angular_momentum))
 
     # --- loads --------------------------------------------------------------------------------------
 
@@ -271,7 +272,7 @@ class Body:
         r = self.rotation
         with np.errstate(over="ignore", invalid="ignore"):
             velocity, momentum = linvel + impulse * inv_mass, angmom + np.cross(lever, impulse)
-            omega = r @ (self._mass()[3] @ (r.T @ momentum))
+            omega = matvec(r, matvec(self._mass()[3], matvec(r.T, momentum)))
         velocity = finite_result(velocity, "impulse", impulse, f"on a body of {self.mass:g} kg gives the velocity")
         finite_result(momentum, "impulse", impulse, f"at point {listed(point)} gives the angular momentum")
         finite_result(omega, "impulse", impulse, "gives the angular velocity")

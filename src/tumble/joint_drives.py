@@ -23,6 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from . import portable
 from .math3d import quat_mul, quat_to_mat33
 
 __all__ = ["JointDrive", "JointDrives"]
@@ -96,7 +97,7 @@ class JointDrives:
             c = float(self.ctrl[d.index])
             if d.ctrl_range is not None:
                 c = min(max(c, d.ctrl_range[0]), d.ctrl_range[1])
-            out[k] = d.gain * c + d.bias @ (1.0, d.gear * (d.ref + q), d.gear * qd)
+            out[k] = d.gain * c + portable.dot(d.bias, (1.0, d.gear * (d.ref + q), d.gear * qd))
         return out, multi
 
     def apply(self, world, t) -> None:
@@ -147,22 +148,26 @@ def _angles(world, drive: JointDrive, angular_velocities) -> tuple[np.ndarray, n
     index = drive.joint.index
     spec = world._builder.joints[index]
     frame_a, frame_b = joint_frames(world, index)
-    relative = frame_a.T @ frame_b  # b's joint frame in a's
+    relative = portable.matmul(frame_a.T, frame_b)  # b's joint frame in a's
     if drive.axes is None:  # universal: R_x(q₁) R_y(q₂), x carried by a, y by b
-        q = np.array([np.arctan2(relative[2, 1], relative[1, 1]), np.arctan2(relative[0, 2], relative[0, 0])])
+        q = np.array(
+            [portable.arctan2(relative[2, 1], relative[1, 1]), portable.arctan2(relative[0, 2], relative[0, 0])]
+        )
         inverse = np.column_stack([frame_a[:, 0], frame_b[:, 1]])  # orthonormal rows: their transpose
     else:
         basis = drive.axes.T  # columns: the three axes in a's joint frame
-        sense = np.sign(np.linalg.det(basis))
-        r = basis.T @ relative @ basis  # R_x(σq₁) R_y(σq₂) R_z(σq₃)
-        q = sense * np.array([np.arctan2(-r[1, 2], r[2, 2]), np.arcsin(np.clip(r[0, 2], -1.0, 1.0)),
-                              np.arctan2(-r[0, 1], r[0, 0])])  # fmt: skip
+        sense = np.sign(portable.det(basis))
+        r = portable.matmul(portable.matmul(basis.T, relative), basis)  # R_x(σq₁) R_y(σq₂) R_z(σq₃)
+        q = sense * np.array([portable.arctan2(-r[1, 2], r[2, 2]), portable.arcsin(np.clip(r[0, 2], -1.0, 1.0)),
+                              portable.arctan2(-r[0, 1], r[0, 0])])  # fmt: skip
         (ux, uy, uz), v = basis[:, 0], basis[:, 1]  # v turned about u by q₁ (Rodrigues; u ⊥ v)
         u_cross_v = np.array([uy * v[2] - uz * v[1], uz * v[0] - ux * v[2], ux * v[1] - uy * v[0]])
-        turned = np.cos(q[0]) * v + np.sin(q[0]) * u_cross_v
-        inverse = np.linalg.inv(np.array([frame_a @ basis[:, 0], frame_a @ turned, frame_b @ basis[:, 2]]))
+        turned = portable.cos(q[0]) * v + portable.sin(q[0]) * u_cross_v
+        inverse = portable.inverse(
+            portable.matvec(np.array([frame_a, frame_a, frame_b]), np.array([basis[:, 0], turned, basis[:, 2]]))
+        )
     spin_a = np.zeros(3) if spec.body_a < 0 else angular_velocities[spec.body_a]
-    return q, inverse.T @ (angular_velocities[spec.body_b] - spin_a), inverse
+    return q, portable.matvec(inverse.T, angular_velocities[spec.body_b] - spin_a), inverse
 
 
 def _multiply(a: np.ndarray, b: np.ndarray) -> np.ndarray:

@@ -31,6 +31,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from . import portable
 from ._validate import as_float, as_unit_vector3, as_vector3
 from .builder import JointSpec
 from .dynamics.joint_solver import JointKind
@@ -235,7 +236,7 @@ class DistanceJoint(_JointBase):
         anchor_a, anchor_b = as_vector3("anchor_a", anchor_a), as_vector3("anchor_b", anchor_b)
         self._set("anchor", anchor_a)
         self._set("anchor_b", anchor_b)
-        distance = float(np.linalg.norm(anchor_b - anchor_a))
+        distance = float(portable.norm(anchor_b - anchor_a))
         rest = distance if length is None else as_float("length", length, nonnegative=True)
         if rest < 1e-6:
             raise ValueError(
@@ -299,10 +300,11 @@ class UniversalJoint(_JointBase):
         self._set_bodies(a, b, collide_connected)
         self._set("anchor", as_vector3("anchor", anchor))
         axis_a, axis_b = as_unit_vector3("axis_a", axis_a), as_unit_vector3("axis_b", axis_b)
-        if abs(float(axis_a @ axis_b)) > 1e-6:
+        cosine = float(portable.dot(axis_a, axis_b))
+        if abs(cosine) > 1e-6:
             raise ValueError(
                 f"axis_a and axis_b must be perpendicular (a Hooke's joint), got {axis_a.tolist()} and "
-                f"{axis_b.tolist()} at {math.degrees(math.acos(min(abs(float(axis_a @ axis_b)), 1.0))):.6g}°"
+                f"{axis_b.tolist()} at {math.degrees(math.acos(min(abs(cosine), 1.0))):.6g}°"
             )
         self._set("axis_a", axis_a)
         self._set("axis_b", axis_b)
@@ -324,7 +326,7 @@ def _frame_with_x_along(axis: np.ndarray) -> np.ndarray:
     """A unit quaternion whose frame's x axis is ``axis`` (y, z any right-handed completion)."""
     helper = np.array([0.0, 0.0, 1.0]) if abs(axis[2]) < 0.9 else np.array([1.0, 0.0, 0.0])
     y = np.cross(helper, axis)
-    y /= np.linalg.norm(y)
+    y /= portable.norm(y)
     return matrix_to_quat(np.column_stack([axis, y, np.cross(axis, y)]))
 
 
@@ -362,8 +364,8 @@ def joint_spec(joint, world) -> JointSpec:
         # The solver's body a carries the frame's x axis, its body b the y axis (made exactly perpendicular); joined
         # to the world, the world takes a's place (below) and carries axis_b.
         x, y = (joint.axis_a, joint.axis_b) if b is not None else (joint.axis_b, joint.axis_a)
-        y = y - (y @ x) * x
-        y /= np.linalg.norm(y)
+        y = y - portable.dot(y, x) * x
+        y /= portable.norm(y)
         frame = matrix_to_quat(np.column_stack([x, y, np.cross(x, y)]))
     else:
         frame = _frame_with_x_along(axis) if axis is not None else np.array([1.0, 0.0, 0.0, 0.0])

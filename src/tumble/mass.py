@@ -25,6 +25,7 @@ import sys
 
 import numpy as np
 
+from . import portable
 from ._validate import as_array, as_float, as_vector3, mass_or_density
 from .rotation import as_rotation
 
@@ -73,7 +74,7 @@ def _check_inertia(inertia) -> np.ndarray:
     if asymmetry > _SYMMETRY_RTOL * scale:
         raise ValueError(f"inertia must be symmetric, got {_show(tensor)} (largest |I - Iᵀ| entry {asymmetry:.3g})")
     tensor = 0.5 * (tensor + tensor.T)
-    moments = np.linalg.eigvalsh(tensor)
+    moments = portable.eigh(tensor)[0]
     trace = float(np.trace(tensor))
     if moments[0] < -_PSD_RTOL * abs(trace) or trace < 0.0:
         raise ValueError(f"inertia must be positive semi-definite, got eigenvalues {_show(moments)} of {_show(tensor)}")
@@ -87,7 +88,7 @@ def _check_inertia(inertia) -> np.ndarray:
 
 def _shift_term(mass: float, d: np.ndarray) -> np.ndarray:
     """``m (|d|² E - d dᵀ)``: the parallel-axis term for an offset ``d`` (course deck 002)."""
-    return mass * (float(d @ d) * np.eye(3) - np.outer(d, d))
+    return mass * (float(portable.dot(d, d)) * np.eye(3) - np.outer(d, d))
 
 
 class MassProperties:
@@ -128,7 +129,7 @@ class MassProperties:
         """The principal moments, ascending, worked out once (a body checks them, and bodies of one shape and
         scale share them)."""
         if self._moments is None:
-            object.__setattr__(self, "_moments", _readonly(np.linalg.eigvalsh(self._inertia)))
+            object.__setattr__(self, "_moments", _readonly(portable.eigh(self._inertia)[0]))
         return self._moments
 
     def __setattr__(self, name, value):
@@ -182,12 +183,12 @@ class MassProperties:
             point: (3,) [m], a point of the line; default the centre of mass.
         """
         e = as_vector3("axis", axis)
-        norm = float(np.linalg.norm(e))
+        norm = float(portable.norm(e))
         if not norm > 0.0:
             raise ValueError(f"axis must be a non-zero vector, got {_show(e)}")
         e = e / norm
         tensor = self._inertia if point is None else self.inertia_about(point)
-        return float(e @ tensor @ e)
+        return float(portable.dot(e, portable.matvec(tensor, e)))
 
     def transformed(self, rotation=None, translation=None) -> MassProperties:
         """The same body rotated by ``rotation`` and then moved by ``translation``.
@@ -200,8 +201,8 @@ class MassProperties:
         """
         rot = np.eye(3) if rotation is None else as_rotation("rotation", rotation)
         shift = np.zeros(3) if translation is None else as_vector3("translation", translation)
-        inertia = rot @ self._inertia @ rot.T
-        return MassProperties(self._mass, rot @ self._com + shift, 0.5 * (inertia + inertia.T))
+        com = portable.matvec(rot, self._com) + shift
+        return MassProperties(self._mass, com, portable.sandwich(rot, self._inertia))
 
     def principal(self) -> tuple[np.ndarray, np.ndarray]:
         """Principal moments and axes (course deck 000, "Rotational Inertia Diagonalization").
@@ -212,8 +213,8 @@ class MassProperties:
             ``inertia = axes @ diag(moments) @ axes.T``.
             Axes of equal moments are any orthonormal basis of their eigenspace.
         """
-        moments, axes = np.linalg.eigh(self._inertia)
-        if np.linalg.det(axes) < 0.0:
+        moments, axes = portable.eigh(self._inertia)  # Jacobi's method, the course's
+        if portable.det(axes) < 0.0:
             axes[:, 2] = -axes[:, 2]
         return moments, axes
 
@@ -467,9 +468,9 @@ def particles(masses, points) -> MassProperties:
     if p.ndim != 2 or p.shape[0] != m.size:
         raise ValueError(f"points must have shape ({m.size}, 3) to match masses, got shape {p.shape}")
     total = float(m.sum())
-    com = (m @ p) / total
+    com = portable.weighted_sum(m, p) / total
     r = p - com
-    inertia = np.sum(m * np.einsum("ij,ij->i", r, r)) * np.eye(3) - np.einsum("i,ij,ik->jk", m, r, r)
+    inertia = np.sum(m * portable.dot(r, r)) * np.eye(3) - portable.outer_sum(m, r, r)
     return MassProperties(total, com, inertia)
 
 
@@ -550,16 +551,11 @@ def _polyhedron_integrals(vertices: np.ndarray, faces: np.ndarray) -> tuple[floa
     """
     origin = vertices[np.unique(faces)].mean(axis=0)
     a, b, c = (vertices[faces[:, k]] - origin for k in range(3))
-    d = np.einsum("ij,ij->i", a, np.cross(b, c))
+    d = portable.dot(a, np.cross(b, c))
     s = a + b + c
     volume = float(d.sum()) / 6.0
-    first = (d @ s) / 24.0
-    second = (
-        np.einsum("i,ij,ik->jk", d, a, a)
-        + np.einsum("i,ij,ik->jk", d, b, b)
-        + np.einsum("i,ij,ik->jk", d, c, c)
-        + np.einsum("i,ij,ik->jk", d, s, s)
-    ) / 120.0
+    first = portable.weighted_sum(d, s) / 24.0
+    second = sum(portable.outer_sum(d, e, e) for e in (a, b, c, s)) / 120.0
     if volume == 0.0:
         return volume, origin, second
     centroid = first / volume

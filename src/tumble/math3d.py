@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 
+from . import elementary
 from ._jit import inline
 
 # --- vectors -----------------------------------------------------------------------------------------
@@ -200,8 +201,8 @@ def quat_exp(w, h):
     if abs(half) < 1e-4:
         s = 0.5 * h * (1.0 - half * half / 6.0)
     else:
-        s = math.sin(half) / speed
-    return (math.cos(half), w[0] * s, w[1] * s, w[2] * s)
+        s = elementary.sin(half) / speed
+    return (elementary.cos(half), w[0] * s, w[1] * s, w[2] * s)
 
 
 @inline

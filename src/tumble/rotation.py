@@ -25,6 +25,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from . import portable
 from ._validate import _show, as_array, as_quaternion, scaled_down, vector_norm
 
 if TYPE_CHECKING:
@@ -263,7 +264,7 @@ def _sin_half_over(angle: np.ndarray) -> np.ndarray:
     small = angle < _SMALL_ANGLE
     safe = np.where(small, 1.0, angle)
     a2 = np.where(small, angle, 0.0) ** 2  # the series' argument only where it is used (θ² of 1e200 overflows)
-    return np.where(small, 0.5 - a2 / 48.0 + a2 * a2 / 3840.0, np.sin(0.5 * safe) / safe)
+    return np.where(small, 0.5 - a2 / 48.0 + a2 * a2 / 3840.0, portable.sin(0.5 * safe) / safe)
 
 
 def quat_from_axis_angle(axis, angle) -> np.ndarray:
@@ -295,7 +296,7 @@ def quat_from_axis_angle(axis, angle) -> np.ndarray:
         raise ValueError(f"axis must be a non-zero vector, got {_show(axis)}{_where(bad)}")
     unit = scaled / np.where(bad, 1.0, length)[..., None]
     half = 0.5 * angle
-    return _stack(np.cos(half), *np.moveaxis(np.sin(half)[..., None] * unit, -1, 0))
+    return _stack(portable.cos(half), *np.moveaxis(portable.sin(half)[..., None] * unit, -1, 0))
 
 
 def quat_to_axis_angle(q) -> tuple[np.ndarray, np.ndarray]:
@@ -320,7 +321,7 @@ def quat_to_axis_angle(q) -> tuple[np.ndarray, np.ndarray]:
     q = _positive_w(q)
     u = q[..., 1:]
     length = np.linalg.norm(u, axis=-1)
-    angle = 2.0 * np.arctan2(length, q[..., 0])
+    angle = 2.0 * portable.arctan2(length, q[..., 0])
     identity = length == 0.0
     axis = np.where(identity[..., None], np.array([1.0, 0.0, 0.0]), u / np.where(identity, 1.0, length)[..., None])
     return axis, angle
@@ -352,7 +353,7 @@ def quat_from_rotvec(r) -> np.ndarray:
             f"r must be rotation vectors of finite length (angle), got {_show(r)}{_where(~np.isfinite(angle))}"
         )
     vector = _sin_half_over(angle)[..., None] * r
-    return _stack(np.cos(0.5 * angle), *np.moveaxis(vector, -1, 0))
+    return _stack(portable.cos(0.5 * angle), *np.moveaxis(vector, -1, 0))
 
 
 def quat_to_rotvec(q) -> np.ndarray:
@@ -383,7 +384,7 @@ def quat_to_rotvec(q) -> np.ndarray:
     s2 = (length / safe_w) ** 2
     series = (2.0 / safe_w) * (1.0 - s2 / 3.0 + s2 * s2 / 5.0)
     safe_length = np.where(small, 1.0, length)
-    closed = 2.0 * np.arctan2(length, w) / safe_length
+    closed = 2.0 * portable.arctan2(length, w) / safe_length
     return np.where(small, series, closed)[..., None] * u
 
 
@@ -552,13 +553,13 @@ def quat_slerp(q0, q1, t) -> np.ndarray:
     q1 = _unit("q1", q1)
     # Shortest path: q1 and -q1 are the same rotation; take the one in q0's hemisphere.
     q1 = np.where(np.sum(q0 * q1, axis=-1, keepdims=True) < 0.0, -q1, q1)
-    omega = 2.0 * np.arctan2(np.linalg.norm(q1 - q0, axis=-1), np.linalg.norm(q1 + q0, axis=-1))
+    omega = 2.0 * portable.arctan2(np.linalg.norm(q1 - q0, axis=-1), np.linalg.norm(q1 + q0, axis=-1))
     omega, t = np.broadcast_arrays(omega, t)
     small = omega < _SLERP_LERP_ANGLE
     safe_omega = np.where(small, 1.0, omega)
-    sin_omega = np.sin(safe_omega)
-    c0 = np.where(small, 1.0 - t, np.sin((1.0 - t) * safe_omega) / sin_omega)
-    c1 = np.where(small, t, np.sin(t * safe_omega) / sin_omega)
+    sin_omega = portable.sin(safe_omega)
+    c0 = np.where(small, 1.0 - t, portable.sin((1.0 - t) * safe_omega) / sin_omega)
+    c1 = np.where(small, t, portable.sin(t * safe_omega) / sin_omega)
     q = c0[..., None] * q0 + c1[..., None] * q1
     # Exact slerp is already unit; this removes rounding and is the "normalised" of normalised lerp.
     return q / np.linalg.norm(q, axis=-1, keepdims=True)

@@ -10,6 +10,7 @@ import math
 
 import numpy as np
 
+from . import portable
 from .joints import BallJoint, HingeJoint, SliderJoint
 from .rotation import quat_from_axis_angle, quat_from_rotvec
 from .shapes import Box, Capsule, ConvexHull, Cylinder, Plane, Sphere, TriMesh
@@ -111,8 +112,8 @@ def card_house(levels: int = 2, card=(0.06, 0.001 * 8, 0.09), angle_deg: float =
     world.add_static(Plane(), name="ground", friction=0.9)
     width, thick, height = card
     tilt = np.radians(angle_deg)
-    half_span = height / 2 * np.sin(tilt) + thick / 2 * np.cos(tilt)
-    rise = height * np.cos(tilt) + thick * np.sin(tilt)  # height of a leaning card, corners included
+    half_span = height / 2 * portable.sin(tilt) + thick / 2 * portable.cos(tilt)
+    rise = height * portable.cos(tilt) + thick * portable.sin(tilt)  # height of a leaning card, corners included
     z0 = 0.0
     for level in range(levels):
         pairs = levels - level
@@ -159,7 +160,7 @@ def friction_ramp(theta_deg: float = 30.0, frictions=(0.2, 0.4, 0.6, 0.8), **wor
     ``μ > tan θ`` hold, the others slide. Box ``k`` is named ``"mu=<value>"``."""
     world = World(**world_settings)
     theta = np.radians(theta_deg)
-    normal = np.array([-np.sin(theta), 0.0, np.cos(theta)])
+    normal = np.array([-portable.sin(theta), 0.0, portable.cos(theta)])
     world.add_static(Plane(normal=normal), name="ramp", friction=1.0)
     q = quat_from_axis_angle((0, 1, 0), -theta)
     for k, mu in enumerate(frictions):
@@ -214,7 +215,7 @@ def bowl_mesh(radius: float = 1.5, depth: float = 0.6, segments: int = 24, rings
         r = radius * ring / rings
         for k in range(segments):
             a = 2 * np.pi * k / segments
-            vertices.append((r * np.cos(a), r * np.sin(a), depth * (r / radius) ** 2))
+            vertices.append((r * portable.cos(a), r * portable.sin(a), depth * (r / radius) ** 2))
     faces = []
     for k in range(segments):
         faces.append((0, 1 + k, 1 + (k + 1) % segments))
@@ -261,11 +262,11 @@ def _capsule_between(p, q, radius: float) -> tuple[Capsule, np.ndarray, np.ndarr
     orientation that turns its z axis onto ``q − p``."""
     p, q = np.asarray(p, np.float64), np.asarray(q, np.float64)
     span = q - p
-    extent = float(np.linalg.norm(span))
+    extent = float(portable.norm(span))
     direction = span / extent
     axis = np.cross((0.0, 0.0, 1.0), direction)
-    sine = float(np.linalg.norm(axis))
-    angle = float(np.arctan2(sine, direction[2]))
+    sine = float(portable.norm(axis))
+    angle = float(portable.arctan2(sine, direction[2]))
     if sine < 1e-12:  # along ±z: no turn, or a half turn about x
         axis = np.array([1.0, 0.0, 0.0])
     return Capsule(radius, max(extent - 2 * radius, 0.0)), (p + q) / 2, quat_from_axis_angle(axis, angle)
@@ -273,7 +274,7 @@ def _capsule_between(p, q, radius: float) -> tuple[Capsule, np.ndarray, np.ndarr
 
 def _in_plane(angle: float) -> np.ndarray:
     """The unit vector at ``angle`` [rad] counter-clockwise from +x in the x–z plane (x right, z up)."""
-    return np.array([np.cos(angle), 0.0, np.sin(angle)])
+    return np.array([portable.cos(angle), 0.0, portable.sin(angle)])
 
 
 # Hinges in the x–z plane turn about −y, so that a positive angle is counter-clockwise as drawn (x right, z up).
@@ -330,9 +331,9 @@ def _four_bar_joint(ground: float, crank: float, coupler: float, rocker: float, 
     (``ground``, 1) as (x, z)), with the crank at ``theta`` [rad] counter-clockwise from +x: the upper of the two
     intersections of the circles of radius ``coupler`` about the crank pin and ``rocker`` about the rocker's
     pivot. Returns (3,) [m], world frame."""
-    pin = np.array([crank * np.cos(theta), 1.0 + crank * np.sin(theta)])
+    pin = np.array([crank * portable.cos(theta), 1.0 + crank * portable.sin(theta)])
     pivot = np.array([ground, 1.0])
-    d = float(np.linalg.norm(pivot - pin))
+    d = float(portable.norm(pivot - pin))
     along = (coupler**2 - rocker**2 + d**2) / (2 * d)  # from the pin towards the pivot
     across = math.sqrt(coupler**2 - along**2)
     u = (pivot - pin) / d
@@ -366,7 +367,7 @@ def four_bar(
 
     v_pin = speed * perp(pin - o_crank)
     closure = np.column_stack([perp(joint - pin)[[0, 2]], -perp(joint - o_rocker)[[0, 2]]])
-    w_coupler, w_rocker = np.linalg.solve(closure, -v_pin[[0, 2]])
+    w_coupler, w_rocker = portable.solve(closure, -v_pin[[0, 2]])
     links = {
         "crank": (o_crank, pin, o_crank, np.zeros(3), speed),
         "coupler": (pin, joint, pin, v_pin, w_coupler),
@@ -416,14 +417,14 @@ def _hanging_chain(links: int, pitch: float, span: float) -> np.ndarray:
     turn = np.arange(links) - (links - 1) / 2
 
     def extent(ratio: float) -> float:
-        return float(pitch * np.cos(np.arctan(ratio * turn)).sum())
+        return float(pitch * portable.cos(portable.arctan(ratio * turn)).sum())
 
     lo, hi = 0.0, 1e3
     for _ in range(100):
         mid = (lo + hi) / 2
         lo, hi = (mid, hi) if extent(mid) > span else (lo, mid)
-    angles = np.arctan(lo * turn)
-    steps = pitch * np.column_stack([np.cos(angles), np.sin(angles)])
+    angles = portable.arctan(lo * turn)
+    steps = pitch * np.column_stack([portable.cos(angles), portable.sin(angles)])
     return np.vstack([np.zeros(2), np.cumsum(steps, axis=0)])
 
 
@@ -449,7 +450,7 @@ def rope_bridge(planks: int = 12, **world_settings) -> World:
             Box((pitch - 0.05, width, thickness)),
             density=600.0,
             position=((x0 + x1) / 2, 0.0, (z0 + z1) / 2),
-            orientation=quat_from_axis_angle(_PLANAR_AXIS, np.arctan2(z1 - z0, x1 - x0)),
+            orientation=quat_from_axis_angle(_PLANAR_AXIS, portable.arctan2(z1 - z0, x1 - x0)),
             linear_damping=1.0,
             angular_damping=1.0,
             name=f"plank{i}",

@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from . import portable
 from ._jit import kernel
 from ._validate import as_float, as_seed, as_vector3
 from .handles import as_body, as_new_part
@@ -85,7 +86,7 @@ class IMU(Sensor):
     def _reading_now(self):
         # Before any step: a body not accelerating, whose specific force is −g.
         quat, angular_velocity = self._world._sensors.imu_now(self._world, self)
-        return quat_to_matrix(quat).T @ -self._world.gravity, angular_velocity
+        return portable.matvec(quat_to_matrix(quat).T, -self._world.gravity), angular_velocity
 
     def _take(self, specific_force: np.ndarray, angular_velocity: np.ndarray, dt: float) -> None:
         """Add this step's bias walk and noise to the true values."""

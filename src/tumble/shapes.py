@@ -29,6 +29,7 @@ from enum import IntEnum
 import numpy as np
 
 from . import mass as _mass
+from . import portable
 from ._validate import _show, as_array, as_float, as_unit_vector3, as_vector3
 
 __all__ = [
@@ -438,7 +439,7 @@ class ConvexHull(Shape):
         # Orient every triangle along its facet's outward normal (the first three entries of `equations`).
         a, b, c = (vertices[faces[:, k]] for k in range(3))
         normals = np.cross(b - a, c - a)
-        inward = np.einsum("ij,ij->i", normals, hull.equations[:, :3]) < 0.0
+        inward = portable.dot(normals, hull.equations[:, :3]) < 0.0
         faces[inward] = faces[inward][:, [0, 2, 1]]
         try:
             volume = _mass._closed_mesh_integrals(vertices, faces)[0]
@@ -454,7 +455,7 @@ class ConvexHull(Shape):
 
     def support(self, direction) -> np.ndarray:
         d = _unit_direction(direction)
-        return self._vertices[int(np.argmax(self._vertices @ d))].copy()
+        return self._vertices[int(np.argmax(portable.dot(self._vertices, d)))].copy()
 
     def __repr__(self) -> str:
         return f"ConvexHull(<{len(self._vertices)} vertices, {len(self._faces)} faces>)"
@@ -496,7 +497,7 @@ class TriMesh(Shape):
         """The farthest vertex along ``direction``: the support point of the mesh's convex hull."""
         d = _unit_direction(direction)
         used = self._vertices[np.unique(self._faces)]
-        return used[int(np.argmax(used @ d))].copy()
+        return used[int(np.argmax(portable.dot(used, d)))].copy()
 
     def __repr__(self) -> str:
         return f"TriMesh(<{len(self._vertices)} vertices, {len(self._faces)} faces>)"

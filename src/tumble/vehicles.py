@@ -21,6 +21,7 @@ from types import MappingProxyType
 
 import numpy as np
 
+from . import portable
 from ._validate import as_array, as_float, as_vector3
 from .actuators import Rotor, command_all
 from .flight.kernels import allocate_speeds
@@ -55,7 +56,7 @@ def quadrotor_params(**values) -> Mapping:
     if p["speed_min"] >= p["speed_max"]:
         raise ValueError(f"speed_min must be < speed_max, got {p['speed_min']!r} >= {p['speed_max']!r}")
     inertia = as_array("inertia", values["inertia"], (3, 3), batch=False)
-    if not np.allclose(inertia, inertia.T, rtol=1e-12, atol=0.0) or np.linalg.eigvalsh(inertia)[0] <= 0.0:
+    if not np.allclose(inertia, inertia.T, rtol=1e-12, atol=0.0) or portable.eigh(inertia)[0][0] <= 0.0:
         raise ValueError(f"inertia must be symmetric and positive definite, got {inertia.tolist()}")
     directions = as_array("rotor_directions", values["rotor_directions"], (4,), batch=False)
     if not np.all(np.abs(directions) == 1.0):
@@ -112,7 +113,7 @@ class Mixer:
                  speed_min: float, speed_max: float):  # fmt: skip
         matrix = np.vstack([np.ones(4), positions[:, 1], -positions[:, 0], spins * (k_moment / k_thrust)])
         self.matrix = k_thrust * matrix
-        self.inverse = np.linalg.inv(self.matrix)
+        self.inverse = portable.inverse(self.matrix)
         for array in (self.matrix, self.inverse):
             array.flags.writeable = False
         self.k_thrust = k_thrust
@@ -121,7 +122,7 @@ class Mixer:
     def wrench(self, rotor_speeds) -> np.ndarray:
         """``(T, Mx, My, Mz)`` of the rotors at ``rotor_speeds`` (4,) [rad/s]."""
         speeds = as_array("rotor_speeds", rotor_speeds, (4,), batch=False)
-        return self.matrix @ speeds**2
+        return portable.matvec(self.matrix, speeds**2)
 
     def allocate(self, thrust, moments) -> np.ndarray:
         """Rotor speeds (4,) [rad/s] that make the collective ``thrust`` [N] and body ``moments`` (3,) [N m].
@@ -222,7 +223,7 @@ class Quadrotor:
     @property
     def hover_rotor_speed(self) -> float:
         """The speed at which the four rotors carry the weight: ``√(m g / (4 k_thrust))`` [rad/s]."""
-        g = float(np.linalg.norm(self.world.gravity))
+        g = float(portable.norm(self.world.gravity))
         return math.sqrt(self.params["mass"] * g / (4.0 * self.params["k_thrust"]))
 
     def state(self) -> dict[str, np.ndarray]:

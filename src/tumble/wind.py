@@ -20,6 +20,7 @@ import math
 
 import numpy as np
 
+from . import elementary, portable
 from ._validate import as_float, as_seed, as_vector3
 
 __all__ = ["Constant", "Dryden", "Sinusoid", "Wind"]
@@ -55,7 +56,7 @@ class Sinusoid(Wind):
         self.frequency = as_float("frequency", frequency, nonnegative=True)
 
     def velocity(self, t: float, dt: float) -> np.ndarray:
-        return self.mean + self.amplitude * math.sin(2.0 * math.pi * self.frequency * (t + 0.5 * dt))
+        return self.mean + self.amplitude * elementary.sin(2.0 * math.pi * self.frequency * (t + 0.5 * dt))
 
     def __repr__(self) -> str:
         return f"Sinusoid({self.mean.tolist()}, {self.amplitude.tolist()}, {self.frequency!r})"
@@ -84,7 +85,7 @@ class Dryden(Wind):
 
     def __init__(self, mean, sigma, length_scale, seed=None):
         self.mean = as_vector3("mean", mean)
-        speed = float(np.linalg.norm(self.mean))
+        speed = float(portable.norm(self.mean))
         if not speed > 0.0:
             raise ValueError(
                 f"mean must be a non-zero wind (its speed carries the turbulence), got {self.mean.tolist()}"
@@ -96,65 +97,78 @@ class Dryden(Wind):
         # The wind frame: u along the mean wind, w as near world up as can be, v = w × u.
         u = self.mean / speed
         up = np.array([0.0, 0.0, 1.0]) if abs(u[2]) < 0.999 else np.array([1.0, 0.0, 0.0])
-        w = up - np.dot(up, u) * u
-        w /= np.linalg.norm(w)
+        w = up - portable.dot(up, u) * u
+        w /= portable.norm(w)
         self.axes = np.stack([u, np.cross(w, u), w], axis=1)  # columns u, v, w in the world frame
         # The three filters side by side: one state x (1 + 2 + 2), gust = C x.
         filters = [_shaping_filter(k == 0, self.sigma[k], self.correlation_time[k]) for k in range(3)]
-        size = sum(a.shape[0] for a, _, _ in filters)
-        self._a, self._c, self._p = np.zeros((size, size)), np.zeros((3, size)), np.zeros((size, size))
-        start = 0
-        for k, (a, c, p) in enumerate(filters):
-            block = slice(start, start + a.shape[0])
-            self._a[block, block], self._c[k, block], self._p[block, block] = a, c, p
-            start += a.shape[0]
+        self._c, self._p = np.zeros((3, _SIZE)), np.zeros((_SIZE, _SIZE))
+        for k, (c, p) in enumerate(filters):
+            self._c[k, _BLOCKS[k]], self._p[_BLOCKS[k], _BLOCKS[k]] = c, p
         self._rng = np.random.default_rng(seed)
         self._state = self._sample(self._p)  # stationary from the start
         self._transitions: dict[float, tuple[np.ndarray, np.ndarray]] = {}
-        self.gust = self._c @ self._state
+        self.gust = portable.matvec(self._c, self._state)
 
     def _sample(self, covariance: np.ndarray) -> np.ndarray:
-        return _root(covariance) @ self._rng.standard_normal(covariance.shape[0])
+        return portable.matvec(_root(covariance), self._rng.standard_normal(covariance.shape[0]))
 
     def _transition(self, dt: float) -> tuple[np.ndarray, np.ndarray]:
         """``Φ = e^(A dt)`` and a square root of the exact noise covariance ``P − Φ P Φᵀ`` over ``dt``."""
         if dt not in self._transitions:
-            from scipy.linalg import expm  # SciPy loads on first use: import tumble stays light
-
-            phi = expm(self._a * dt)
-            self._transitions[dt] = phi, _root(self._p - phi @ self._p @ phi.T)
+            phi = np.zeros((_SIZE, _SIZE))
+            for k in range(3):
+                phi[_BLOCKS[k], _BLOCKS[k]] = _filter_transition(k == 0, self.correlation_time[k], dt)
+            noise = self._p - portable.matmul(portable.matmul(phi, self._p), phi.T)
+            self._transitions[dt] = phi, _root(noise)
         return self._transitions[dt]
 
     def velocity(self, t: float, dt: float) -> np.ndarray:
         """Advance the gusts by one step of ``dt`` and return the mean wind plus them."""
         phi, root = self._transition(as_float("dt", dt, positive=True))
-        self._state = phi @ self._state + root @ self._rng.standard_normal(root.shape[1])
-        self.gust = self._c @ self._state
-        return self.mean + self.axes @ self.gust
+        self._state = portable.matvec(phi, self._state) + portable.matvec(
+            root, self._rng.standard_normal(root.shape[1])
+        )
+        self.gust = portable.matvec(self._c, self._state)
+        return self.mean + portable.matvec(self.axes, self.gust)
 
     def __repr__(self) -> str:
         return f"Dryden({self.mean.tolist()}, {self.sigma.tolist()}, {self.length_scale.tolist()}, seed={self.seed})"
 
 
-def _shaping_filter(longitudinal: bool, sigma: float, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """``(A, c, P)``: state matrix, output row and stationary state covariance of a filter whose output has the
-    Dryden autocorrelation of standard deviation ``sigma`` and time ``t`` (unit white noise into the last state)."""
-    if longitudinal:  # ẋ = −x/T + ξ, u = c x
-        a, b, c = np.array([[-1.0 / t]]), np.array([[1.0]]), np.array([1.0])
-    else:  # (1 + √3 T s) / (1 + T s)²: a double pole at −1/T and a zero at −1/(√3 T)
-        a = np.array([[0.0, 1.0], [-1.0 / t**2, -2.0 / t]])
-        b = np.array([[0.0], [1.0]])
-        c = np.array([1.0, math.sqrt(3.0) * t])
-    from scipy.linalg import solve_continuous_lyapunov
+# The three filters side by side in one state x (1 + 2 + 2), gust = C x: the rows of each.
+_BLOCKS = (slice(0, 1), slice(1, 3), slice(3, 5))
+_SIZE = 5
 
-    p = solve_continuous_lyapunov(a, -b @ b.T)
-    c = c * sigma / math.sqrt(c @ p @ c)
-    return a, c, p
+
+def _shaping_filter(longitudinal: bool, sigma: float, t: float) -> tuple[np.ndarray, np.ndarray]:
+    """``(c, P)``: output row and stationary state covariance of a filter whose output has the Dryden autocorrelation
+    of standard deviation ``sigma`` and time ``t`` (unit white noise into the last state).
+
+    ``P`` solves the Lyapunov equation ``A P + P Aᵀ + b bᵀ = 0`` in closed form: ``T/2`` for ``ẋ = −x/T + ξ``; for
+    ``ẍ + 2ω ẋ + ω² x = ξ`` (``ω = 1/T``) the diagonal ``(1/(4ω³), 1/(4ω))``, the variances of a critically damped
+    oscillator driven by unit white noise (e.g. Gardiner, Stochastic Methods, §3.8.4)."""
+    if longitudinal:  # ẋ = −x/T + ξ, u = c x
+        c, p = np.array([1.0]), np.array([[0.5 * t]])
+    else:  # (1 + √3 T s) / (1 + T s)²: a double pole at −1/T and a zero at −1/(√3 T)
+        c, p = np.array([1.0, math.sqrt(3.0) * t]), np.diag([0.25 * t**3, 0.25 * t])
+    c = c * sigma / math.sqrt(float(np.sum(c * portable.matvec(p, c))))  # cᵀ P c
+    return c, p
+
+
+def _filter_transition(longitudinal: bool, t: float, dt: float) -> np.ndarray:
+    """``Φ = e^(A dt)`` of a shaping filter in closed form: ``e^(−dt/T)``, and for the double pole ``A = −ω I + N``
+    with ``N² = 0``, ``e^(−ω dt) (I + N dt)``."""
+    decay = elementary.exp(-dt / t)
+    if longitudinal:
+        return np.array([[decay]])
+    w = 1.0 / t
+    return decay * np.array([[1.0 + w * dt, dt], [-w * w * dt, 1.0 - w * dt]])
 
 
 def _root(covariance: np.ndarray) -> np.ndarray:
     """``S`` with ``S Sᵀ = covariance`` for a symmetric positive semi-definite matrix (round-off clipped)."""
-    values, vectors = np.linalg.eigh(0.5 * (covariance + covariance.T))
+    values, vectors = portable.eigh(0.5 * (covariance + covariance.T))
     return vectors * np.sqrt(np.clip(values, 0.0, None))
 
 

@@ -14,7 +14,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from . import diagnostics
+from . import diagnostics, portable
 from ._validate import (
     MAX_COUNT,
     as_array,
@@ -418,9 +418,11 @@ class World:
                              f"{joint.kind} joint")  # fmt: skip
         if axes is not None:
             axes = as_array("axes", axes, (3, 3), batch=False)
-            if not np.allclose(axes @ axes.T, np.eye(3), rtol=0.0, atol=1e-6):
+            if not np.allclose(portable.matmul(axes, axes.T), np.eye(3), rtol=0.0, atol=1e-6):
                 raise ValueError(f"axes must be three orthonormal rows, got {axes.tolist()}")
-            axes = axes @ joint_frames(self, joint.index)[0]  # in the joint's frame on its (solver's) first body
+            axes = portable.matmul(
+                axes, joint_frames(self, joint.index)[0]
+            )  # in the joint's frame on its (solver's) first body
         if self._joint_drives is None:
             self._joint_drives = JointDrives()
         return self._joint_drives.add(self, joint, gear=gear, gain=gain, bias=bias, ctrl_range=ctrl_range, ref=ref,

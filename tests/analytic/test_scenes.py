@@ -48,16 +48,41 @@ def test_the_1000_box_pile_settles_without_sinking_into_the_ground():
     assert max((np.linalg.norm(b.velocity) for b in moving), default=0.0) < 0.1
 
 
-def test_a_mixed_pile_stays_in_the_mesh_bowl():
-    world = scenes.mixed_pile(40)
-    traj = world.simulate(4.0, DT)
+def mesh_height(mesh, points) -> np.ndarray:
+    """The height of an upward-facing mesh (one sheet over the xy plane) under each of ``points`` (..., 3): the
+    plane of the triangle whose projection holds the point; NaN outside the mesh."""
+    v, f = mesh.vertices, mesh.faces
+    a, b, c = v[f[:, 0]], v[f[:, 1]], v[f[:, 2]]
+    xy = points[..., None, :2]  # (..., 1, 2) against (faces, 2)
+    det = (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (c[:, 0] - a[:, 0]) * (b[:, 1] - a[:, 1])
+    u = ((xy[..., 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (c[:, 0] - a[:, 0]) * (xy[..., 1] - a[:, 1])) / det
+    w = ((b[:, 0] - a[:, 0]) * (xy[..., 1] - a[:, 1]) - (xy[..., 0] - a[:, 0]) * (b[:, 1] - a[:, 1])) / det
+    inside = (u >= -1e-12) & (w >= -1e-12) & (u + w <= 1.0 + 1e-12)
+    z = a[:, 2] + u * (b[:, 2] - a[:, 2]) + w * (c[:, 2] - a[:, 2])
+    return np.where(inside.any(axis=-1), np.nanmax(np.where(inside, z, -np.inf), axis=-1), np.nan)
+
+
+def mixed_pile_depths(seed: int, rate: float, count: int = 40, duration: float = 4.0):
+    """``scenes.mixed_pile(count, seed)`` run at ``rate`` Hz: how far below the bowl's surface any body's centre of
+    mass went at any step [m] (negative: none did), and the share of the bodies over the bowl at the end."""
+    world = scenes.mixed_pile(count, seed=seed)
+    bowl = scenes.bowl_mesh()  # the one mixed_pile puts into the world
     dynamic = [b.index for b in world.bodies if not b.is_static]
-    radius = np.linalg.norm(traj.position[:, dynamic, :2], axis=2)
-    inside = radius < 1.4
-    bowl_height = 0.6 * (radius / 1.5) ** 2  # scenes.bowl_mesh's paraboloid
-    # Nothing falls through the one-sided mesh: every centre over the bowl stays above its surface.
-    assert (traj.position[:, dynamic, 2] - bowl_height)[inside].min() > -0.01
-    assert inside[-1].mean() > 0.9  # and the pile stays in the bowl (a ball may roll over the rim)
+    centres = world.simulate(duration, 1.0 / rate).center_of_mass[:, dynamic]
+    below = mesh_height(bowl, centres) - centres[..., 2]  # NaN where a centre is off the bowl (over its rim)
+    over_the_bowl = np.hypot(centres[-1, :, 0], centres[-1, :, 1]) < 1.4
+    return float(np.nanmax(below)), float(over_the_bowl.mean())
+
+
+# Nothing falls through the one-sided mesh: no centre of mass goes 1 cm below its surface (issue 44; measured at
+# 60 Hz over seeds 1-10: at most 0.52 cm above it, i.e. none below). The centre, not the frame origin: a hull's
+# origin lies where its points were drawn around, centimetres from its centre of mass. And the pile stays in the
+# bowl (a ball may roll over the rim).
+@pytest.mark.parametrize("seed", [1, 2, 3])
+def test_a_mixed_pile_stays_in_the_mesh_bowl(seed):
+    below, kept = mixed_pile_depths(seed, 60.0)
+    assert below < 0.01
+    assert kept > 0.9
 
 
 def test_a_row_of_dominoes_topples_to_the_last():

@@ -18,6 +18,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .. import portable
+
 __all__ = ["Actuator", "actuator_forces", "drive_columns"]
 
 
@@ -62,5 +64,5 @@ def actuator_forces(actuators, dofs: list[int], q_rows: list[int], ctrl: np.ndar
     forces = np.zeros(len(actuators))
     for a, (actuator, k, row) in enumerate(zip(actuators, dofs, q_rows, strict=True)):
         length, speed = actuator.gear * q[row], actuator.gear * qd[k]
-        forces[a] = actuator.gain * actuator.control(ctrl) + actuator.bias @ (1.0, length, speed)
+        forces[a] = actuator.gain * actuator.control(ctrl) + portable.dot(actuator.bias, (1.0, length, speed))
     return forces

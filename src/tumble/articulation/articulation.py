@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .. import portable
 from .._validate import (
     _show,
     as_array,
@@ -426,7 +427,7 @@ class Articulation:
         local = np.zeros(3) if point is None else as_vector3("point", point)
         m, w = self._evaluate(KINEMATICS, q=q, qd=self._compile().zero_v)
         row = w.link_work[index]
-        x = row[POS : POS + 3] + quat_to_matrix(row[QUAT : QUAT + 4]) @ local
+        x = row[POS : POS + 3] + portable.matvec(quat_to_matrix(row[QUAT : QUAT + 4]), local)
         jac = np.zeros((6, self.nv))
         k = int(m.link_ints[index, DOF_TIP])
         while k >= 0:

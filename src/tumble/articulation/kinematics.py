@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import math
 
+from .. import elementary
 from .._jit import inline
 from ..math3d import (
     add,
@@ -87,8 +88,8 @@ def joint_quat(q, start):
 def _axis_angle_quat(axis, angle):
     if not math.isfinite(angle):  # as in quat_exp
         return (math.nan, math.nan, math.nan, math.nan)
-    s = math.sin(0.5 * angle)
-    return (math.cos(0.5 * angle), axis[0] * s, axis[1] * s, axis[2] * s)
+    s = elementary.sin(0.5 * angle)
+    return (elementary.cos(0.5 * angle), axis[0] * s, axis[1] * s, axis[2] * s)
 
 
 @inline

@@ -23,6 +23,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from .. import elementary
 from .._jit import inline, kernel
 from ..math3d import add, add_scaled, cross, dot, load3, quat_rotate, quat_rotate_inv, scale, sub
 
@@ -64,7 +65,7 @@ def motor_speed(speed, command, time_constant, tau):
     """The motor's speed ``tau`` after the start of the call: first-order lag towards the command, exact."""
     if time_constant <= 0.0:
         return command
-    return command + (speed - command) * math.exp(-tau / time_constant)
+    return command + (speed - command) * elementary.exp(-tau / time_constant)
 
 
 @inline

@@ -44,6 +44,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from .. import elementary
 from .._jit import inline, kernel
 from ..math3d import (
     add,
@@ -167,7 +168,7 @@ def _wrap_angle(angle):
 def _hinge_angle(fa, fb):
     """The twist of ``b``'s joint frame relative to ``a``'s about the x axis, in (−π, π]."""
     rel = quat_mul(quat_conj(fa), fb)
-    return _wrap_angle(2.0 * math.atan2(rel[1], rel[0]))
+    return _wrap_angle(2.0 * elementary.atan2(rel[1], rel[0]))
 
 
 @inline
@@ -401,7 +402,7 @@ def _swing(fa, fb):
     turn = cross(na, nb)
     sine = math.sqrt(dot(turn, turn))
     axis = scale(turn, 1.0 / sine) if sine > 1e-9 else _EY
-    return math.atan2(sine, dot(na, nb)), axis
+    return elementary.atan2(sine, dot(na, nb)), axis
 
 
 @inline
@@ -594,12 +595,14 @@ def joint_coordinates(joints, pos, quat, linvel, angvel, first, stop, out):
         out[j - first, 2] = math.sqrt(dot(d, d))
         if kind == HINGE or kind == PLANAR:
             na, nb = quat_rotate(fa, _EX), quat_rotate(fb, _EX)
-            out[j - first, 3] = math.atan2(math.sqrt(dot(cross(na, nb), cross(na, nb))), dot(na, nb))
+            out[j - first, 3] = elementary.atan2(math.sqrt(dot(cross(na, nb), cross(na, nb))), dot(na, nb))
         elif kind == UNIVERSAL:
-            out[j - first, 3] = abs(math.asin(min(max(dot(quat_rotate(fa, _EX), quat_rotate(fb, _EY)), -1.0), 1.0)))
+            out[j - first, 3] = abs(
+                elementary.asin(min(max(dot(quat_rotate(fa, _EX), quat_rotate(fb, _EY)), -1.0), 1.0))
+            )
         elif kind == FIXED or kind == SLIDER:
             q_err = quat_mul(fb, quat_conj(fa))
             sine = math.sqrt(q_err[1] ** 2 + q_err[2] ** 2 + q_err[3] ** 2)
-            out[j - first, 3] = 2.0 * math.atan2(sine, abs(q_err[0]))
+            out[j - first, 3] = 2.0 * elementary.atan2(sine, abs(q_err[0]))
         else:
             out[j - first, 3] = 0.0

@@ -39,6 +39,7 @@ import math
 import numpy as np
 from gymnasium import spaces
 
+from .. import elementary, portable
 from ..articulation import Articulation, Prismatic, Revolute
 from ..shapes import Capsule
 from .canvas import Canvas
@@ -47,7 +48,7 @@ from .core import Task
 __all__ = ["DoublePendulumTask"]
 
 POLE, DENSITY, DAMPING, GEAR = 0.6, 1000.0, 0.05, 500.0
-ALONG_X = (math.cos(math.pi / 4), 0.0, math.sin(math.pi / 4), 0.0)  # the capsule's z axis turned onto x
+ALONG_X = (elementary.cos(math.pi / 4), 0.0, elementary.sin(math.pi / 4), 0.0)  # the capsule's z axis turned onto x
 
 
 class DoublePendulumTask(Task):
@@ -81,14 +82,17 @@ class DoublePendulumTask(Task):
 
     def observe(self, q, qd):
         angles = q[:, 1:]
-        return np.concatenate([q[:, :1], np.sin(angles), np.cos(angles), np.clip(qd, -10.0, 10.0)],
+        return np.concatenate([q[:, :1], portable.sin(angles), portable.cos(angles), np.clip(qd, -10.0, 10.0)],
                               axis=1).astype(np.float32)  # fmt: skip
 
     @staticmethod
     def tip(q):
         """(x, y) of the upper pole's tip (copies,) each [m]."""
         first, second = q[:, 1], q[:, 1] + q[:, 2]
-        return (q[:, 0] + POLE * (np.sin(first) + np.sin(second)), POLE * (np.cos(first) + np.cos(second)))
+        return (
+            q[:, 0] + POLE * (portable.sin(first) + portable.sin(second)),
+            POLE * (portable.cos(first) + portable.cos(second)),
+        )
 
     def reward(self, q0, qd0, actions, q, qd, terminated):
         x, y = self.tip(q)
@@ -104,8 +108,8 @@ class DoublePendulumTask(Task):
         for mark in np.arange(math.floor(q[0] - 3.0), q[0] + 3.0):  # ticks every metre show the cart's motion
             canvas.segment((mark, -0.05), (mark, 0.05), 0.01, (77, 77, 179))
         canvas.segment((q[0] - 0.1, 0.0), (q[0] + 0.1, 0.0), 0.2, (179, 179, 0))
-        elbow = (q[0] + POLE * math.sin(q[1]), POLE * math.cos(q[1]))
-        tip = (elbow[0] + POLE * math.sin(q[1] + q[2]), elbow[1] + POLE * math.cos(q[1] + q[2]))
+        elbow = (q[0] + POLE * elementary.sin(q[1]), POLE * elementary.cos(q[1]))
+        tip = (elbow[0] + POLE * elementary.sin(q[1] + q[2]), elbow[1] + POLE * elementary.cos(q[1] + q[2]))
         canvas.segment((q[0], 0.0), elbow, 0.09, (0, 179, 179))
         canvas.segment(elbow, tip, 0.09, (0, 179, 179))
         return canvas.image

@@ -27,6 +27,7 @@ import math
 import numpy as np
 from gymnasium import spaces
 
+from .. import portable
 from ..articulation import Articulation, Revolute
 from ..mass import MassProperties
 from .canvas import Canvas
@@ -66,7 +67,7 @@ class PendulumTask(Task):
         return torques[:, 0]
 
     def observe(self, q, qd):
-        return np.stack([np.cos(q[:, 0]), np.sin(q[:, 0]), qd[:, 0]], axis=1).astype(np.float32)
+        return np.stack([portable.cos(q[:, 0]), portable.sin(q[:, 0]), qd[:, 0]], axis=1).astype(np.float32)
 
     def reward(self, q0, qd0, actions, q, qd, terminated):
         angle = (q0[:, 0] + math.pi) % (2 * math.pi) - math.pi

@@ -14,6 +14,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from .. import portable
 from .._validate import as_array, as_float, as_quaternion, as_vector3
 from ..rotation import quat_to_matrix
 from . import kernels
@@ -150,7 +151,7 @@ class SE3Controller:
         self.feedforward = bool(feedforward)
         self.integral_limit = as_float("integral_limit", integral_limit, nonnegative=True)
         self._integral = _Integral(self.ki_pos, self.integral_limit)
-        self._inv_inertia = np.linalg.inv(self.quad.params["inertia"])
+        self._inv_inertia = portable.inverse(self.quad.params["inertia"])
 
     def reset(self) -> None:
         """Forget the integral of the position error."""
@@ -200,12 +201,16 @@ class Autopilot:
     def _rates_to_speeds(self, thrust: float, rates_commanded: np.ndarray) -> np.ndarray:
         inertia = self.quad.params["inertia"]
         rates = self.quad.body.angular_velocity_body
-        moments = inertia @ (self.kp_rate * (rates_commanded - rates)) + np.cross(rates, inertia @ rates)
+        moments = portable.matvec(inertia, self.kp_rate * (rates_commanded - rates)) + np.cross(
+            rates, portable.matvec(inertia, rates)
+        )
         return self.quad.mixer.allocate(thrust, moments)
 
     def _attitude_to_speeds(self, thrust: float, desired: np.ndarray, rates_feedforward=(0.0, 0.0, 0.0)):
         rotation = self.quad.body.rotation
-        rates = -self.kp_att * attitude_error(rotation, desired) + rotation.T @ desired @ np.asarray(rates_feedforward)
+        rates = -self.kp_att * attitude_error(rotation, desired) + portable.matvec(
+            portable.matmul(rotation.T, desired), np.asarray(rates_feedforward, np.float64)
+        )
         return self._rates_to_speeds(thrust, rates)
 
     def _acceleration_to_speeds(self, acceleration: np.ndarray, yaw: float, yaw_rate: float = 0.0):
@@ -213,7 +218,7 @@ class Autopilot:
         force = self.quad.params["mass"] * (acceleration - self.quad.world.gravity)
         rotation = self.quad.body.rotation
         desired = desired_rotation(force, yaw)
-        return self._attitude_to_speeds(float(force @ rotation[:, 2]), desired, (0.0, 0.0, yaw_rate))
+        return self._attitude_to_speeds(float(portable.dot(force, rotation[:, 2])), desired, (0.0, 0.0, yaw_rate))
 
     # The command levels.
     def thrust_moments(self, thrust, moments) -> None:

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import math
 
+from .. import elementary
 from .._jit import inline, kernel
 from ..math3d import add, add_scaled, cross, dot, load3, mat_vec, quat_rotate_inv, quat_to_mat33, scale, sub
 
@@ -38,9 +39,9 @@ def desired_axes(force, yaw):
     left."""
     size = math.sqrt(dot(force, force))
     b3 = scale(force, 1.0 / size) if size > 0.0 else (0.0, 0.0, 1.0)
-    b2 = cross(b3, (math.cos(yaw), math.sin(yaw), 0.0))
+    b2 = cross(b3, (elementary.cos(yaw), elementary.sin(yaw), 0.0))
     b2_size = math.sqrt(dot(b2, b2))
-    b2 = scale(b2, 1.0 / b2_size) if b2_size > 1e-9 else (-math.sin(yaw), math.cos(yaw), 0.0)
+    b2 = scale(b2, 1.0 / b2_size) if b2_size > 1e-9 else (-elementary.sin(yaw), elementary.cos(yaw), 0.0)
     return cross(b2, b3), b2, b3
 
 
@@ -150,7 +151,7 @@ def reference_derivatives(kind, params, knot_count, knots, coefficients, t, out)
         out[0, :] = params[:3]
     elif kind == CIRCLE:
         r, w = params[3], 2.0 * math.pi * params[4]
-        c, s = math.cos(w * t), math.sin(w * t)
+        c, s = elementary.cos(w * t), elementary.sin(w * t)
         for k in range(5):  # d^k/dt^k of r (cos wt, sin wt) is r w^k (cos, sin)(wt + k π/2)
             out[k, 0] = r * w**k * (c if k % 4 == 0 else -s if k % 4 == 1 else -c if k % 4 == 2 else s)
             out[k, 1] = r * w**k * (s if k % 4 == 0 else c if k % 4 == 1 else -s if k % 4 == 2 else -c)
@@ -158,8 +159,8 @@ def reference_derivatives(kind, params, knot_count, knots, coefficients, t, out)
     elif kind == LISSAJOUS:
         A, B, a, b, delta = params[3], params[4], params[5], params[6], params[7]
         for k in range(5):  # the k-th derivative of A sin(a t + δ) is A a^k sin(a t + δ + k π/2)
-            out[k, 0] = A * a**k * math.sin(a * t + delta + k * (math.pi / 2))
-            out[k, 1] = B * b**k * math.sin(b * t + k * (math.pi / 2))
+            out[k, 0] = A * a**k * elementary.sin(a * t + delta + k * (math.pi / 2))
+            out[k, 1] = B * b**k * elementary.sin(b * t + k * (math.pi / 2))
         out[0, :] += params[:3]
     else:
         last = knot_count - 1

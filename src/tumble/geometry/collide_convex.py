@@ -46,6 +46,7 @@ import math
 
 import numpy as np
 
+from .. import elementary
 from .._jit import inline, kernel
 from ..math3d import add, add_scaled, cross, dot, quat_rotate, quat_rotate_inv, scale, sub
 from ..shapes import ShapeType
@@ -746,7 +747,7 @@ def _support_feature(geom, shape, face, pos, quat, d, out):
     s = 1.0 if axial >= 0.0 else -1.0
     for k in range(CAP_POINTS):
         ang = 2.0 * math.pi * k / CAP_POINTS
-        ca, sn = math.cos(ang), s * math.sin(ang)
+        ca, sn = elementary.cos(ang), s * elementary.sin(ang)
         corner = (r * (ca * rx - sn * ry), r * (sn * rx + ca * ry), s * half)
         _set_row(out, k, add(pos, quat_rotate(quat, corner)))
     n = quat_rotate(quat, (0.0, 0.0, s))

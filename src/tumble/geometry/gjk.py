@@ -36,6 +36,7 @@ import math
 
 import numpy as np
 
+from .. import elementary
 from .._jit import inline, kernel
 from ..math3d import add, add_scaled, cross, dot, quat_rotate, quat_rotate_inv, scale, sub
 from ..shapes import ShapeType
@@ -594,7 +595,7 @@ def _epa_seed(xa, pa, qa, xb, pb, qb, vertices, va, vb, count, tol):
         best, best_k = -1.0, 0
         for k in range(6):
             ang = k * math.pi / 3.0
-            d = add(scale(e1, math.cos(ang)), scale(e2, math.sin(ang)))
+            d = add(scale(e1, elementary.cos(ang)), scale(e2, elementary.sin(ang)))
             w = _epa_push(xa, pa, qa, xb, pb, qb, vertices, d, va, vb, count)
             off = cross(sub(w, w0), u)
             dist = dot(off, off)
@@ -603,7 +604,7 @@ def _epa_seed(xa, pa, qa, xb, pb, qb, vertices, va, vb, count, tol):
         if best <= tol * tol:
             return 2, hint
         ang = best_k * math.pi / 3.0
-        _epa_push(xa, pa, qa, xb, pb, qb, vertices, add(scale(e1, math.cos(ang)), scale(e2, math.sin(ang))),
+        _epa_push(xa, pa, qa, xb, pb, qb, vertices, add(scale(e1, elementary.cos(ang)), scale(e2, elementary.sin(ang))),
                   va, vb, count)  # fmt: skip
         count += 1
     # A triangle round the origin: the higher of the apexes on either side of its plane (row 4 is scratch).

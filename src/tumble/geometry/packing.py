@@ -12,6 +12,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from .. import portable
 from ..shapes import ConvexHull, Shape, ShapeType, TriMesh
 
 __all__ = ["GeometryArrays", "pack_geometry", "hull_polygons"]
@@ -73,7 +74,7 @@ def hull_polygons(vertices: np.ndarray, triangles: np.ndarray) -> tuple[list[np.
     a, b, c = (vertices[triangles[:, k]] for k in range(3))
     normals = np.cross(b - a, c - a)
     normals /= np.linalg.norm(normals, axis=1, keepdims=True)
-    offsets = np.einsum("ij,ij->i", normals, a)
+    offsets = portable.dot(normals, a)
     scale = max(float(np.ptp(vertices, axis=0).max()), 1e-12)
     unassigned = list(range(len(triangles)))
     loops, face_normals, face_offsets = [], [], []
@@ -84,14 +85,14 @@ def hull_polygons(vertices: np.ndarray, triangles: np.ndarray) -> tuple[list[np.
         group = [
             u
             for u in unassigned
-            if normals[u] @ normals[t] > 1.0 - 1e-9 and abs(offsets[u] - offsets[t]) <= 1e-9 * scale
+            if portable.dot(normals[u], normals[t]) > 1.0 - 1e-9 and abs(offsets[u] - offsets[t]) <= 1e-9 * scale
         ]
         unassigned = [u for u in unassigned if u not in group]
         loops.append(_boundary_loop(triangles[group]))
         mean = normals[group].mean(axis=0)
-        mean /= np.linalg.norm(mean)
+        mean /= portable.norm(mean)
         face_normals.append(mean)
-        face_offsets.append(float(np.mean([mean @ vertices[v] for v in loops[-1]])))
+        face_offsets.append(float(np.mean([portable.dot(mean, vertices[v]) for v in loops[-1]])))
     return loops, np.array(face_normals), np.array(face_offsets)
 
 
@@ -168,7 +169,7 @@ def pack_geometry(shapes: list[Shape], shape_body, pos_local: np.ndarray, quat_l
             shape_normals = np.cross(p1 - p0, p2 - p0)
             lengths = np.linalg.norm(shape_normals, axis=1, keepdims=True)
             shape_normals = shape_normals / np.where(lengths > 0.0, lengths, 1.0)
-            shape_offsets = np.einsum("ij,ij->i", shape_normals, p0)
+            shape_offsets = portable.dot(shape_normals, p0)
         loops.extend(loop + v_total for loop in shape_loops)
         normals.extend(shape_normals)
         offsets.extend(shape_offsets)
@@ -181,7 +182,7 @@ def pack_geometry(shapes: list[Shape], shape_body, pos_local: np.ndarray, quat_l
     lo, hi = lo[bounded], hi[bounded]
     centers, halves = pos_local.copy(), np.full((n, 3), np.inf)
     centers[bounded] += quat_rotate(quat_local[bounded], 0.5 * (lo + hi))
-    halves[bounded] = np.einsum("nij,nj->ni", np.abs(quat_to_matrix(quat_local[bounded])), 0.5 * (hi - lo))
+    halves[bounded] = portable.matvec(np.abs(quat_to_matrix(quat_local[bounded])), 0.5 * (hi - lo))
     loop_counts = np.array([len(lp) for lp in loops], dtype=np.int64)
     loop_starts = (
         np.concatenate([[0], np.cumsum(loop_counts)[:-1]]).astype(np.int64) if loops else np.zeros(0, np.int64)

@@ -27,7 +27,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .. import math3d
+from .. import math3d, portable
 from .._jit import inline, kernel
 from ..shapes import ShapeType
 from .packing import GeometryArrays
@@ -387,7 +387,7 @@ def cast_ray(
     d = np.asarray(direction, dtype=np.float64).reshape(-1)
     if o.shape != (3,) or not np.all(np.isfinite(o)):
         raise ValueError(f"origin must be a finite 3-vector, got {np.asarray(origin).tolist()}")
-    length = float(np.linalg.norm(d)) if d.shape == (3,) else math.nan
+    length = float(portable.norm(d)) if d.shape == (3,) else math.nan
     if not (math.isfinite(length) and length > 0.0):
         raise ValueError(f"direction must be a finite non-zero 3-vector, got {np.asarray(direction).tolist()}")
     max_distance = float(max_distance)

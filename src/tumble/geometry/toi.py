@@ -25,6 +25,7 @@ import math
 
 import numpy as np
 
+from .. import elementary, portable
 from .._jit import inline, kernel
 from ..math3d import add, dot, load3, load4, quat_conj, quat_mul, quat_rotate, quat_rotate_inv, scale, sub
 from ..shapes import ShapeType
@@ -81,7 +82,7 @@ def _fast_bodies(geom, pos0, quat0, pos, quat) -> np.ndarray:
     np.maximum.at(reach, geom.shape_body, np.linalg.norm(geom.shape_aabb_center_local, axis=1)
                   + np.linalg.norm(half, axis=1))  # fmt: skip
     turn = np.abs(np.sum(quat * quat0, axis=1)).clip(0.0, 1.0)
-    motion = np.linalg.norm(pos - pos0, axis=1) + 2.0 * np.arccos(turn) * np.where(np.isfinite(reach), reach, 0.0)
+    motion = np.linalg.norm(pos - pos0, axis=1) + 2.0 * portable.arccos(turn) * np.where(np.isfinite(reach), reach, 0.0)
     return motion > 0.5 * smallest
 
 
@@ -92,10 +93,10 @@ def _pose_at(x0, q0, x1, q1, t):
     if dq[0] < 0.0:
         dq = (-dq[0], -dq[1], -dq[2], -dq[3])
     s = math.sqrt(dq[1] * dq[1] + dq[2] * dq[2] + dq[3] * dq[3])
-    half_angle = math.atan2(s, dq[0]) * t
+    half_angle = elementary.atan2(s, dq[0]) * t
     if s > 0.0:
-        k = math.sin(half_angle) / s
-        turn = (math.cos(half_angle), dq[1] * k, dq[2] * k, dq[3] * k)
+        k = elementary.sin(half_angle) / s
+        turn = (elementary.cos(half_angle), dq[1] * k, dq[2] * k, dq[3] * k)
     else:
         turn = (1.0, 0.0, 0.0, 0.0)
     return add(x0, scale(sub(x1, x0), t)), quat_mul(turn, q0)
@@ -133,7 +134,7 @@ def _advance(geom, proxy, offset, offset_quat, reach, x0, q0, x1, q1, k, pk, qk,
     no point of it farther than ``reach`` from the centre of mass) against static shape ``k``: the first ``t`` at
     which it comes within ``target``, 1 if it never does, -1 if it is that close already at the start."""
     dq = quat_mul(q1, quat_conj(q0))
-    angle = 2.0 * math.atan2(math.sqrt(dq[1] ** 2 + dq[2] ** 2 + dq[3] ** 2), abs(dq[0]))
+    angle = 2.0 * elementary.atan2(math.sqrt(dq[1] ** 2 + dq[2] ** 2 + dq[3] ** 2), abs(dq[0]))
     travel = math.sqrt(dot(sub(x1, x0), sub(x1, x0)))
     speed = travel + angle * reach  # no point of the proxy moves faster, per unit of t
     t = 0.0

@@ -25,6 +25,7 @@ import warnings
 
 import numpy as np
 
+from .. import portable
 from ..joints import BallJoint, HingeJoint, PlanarJoint, SliderJoint, UniversalJoint
 from ..mass import require_invertible
 from ..math3d import quat_mul, quat_rotate
@@ -117,12 +118,12 @@ def _composite(model, body) -> str | None:
     hinges = [j.axis for j in joints if j.type == "hinge"]
     slides = [j.axis for j in joints if j.type == "slide"]
     concurrent = all(np.allclose(j.pos, joints[0].pos, rtol=0.0, atol=1e-9) for j in joints)
-    if types == ["hinge", "hinge"] and concurrent and abs(float(hinges[0] @ hinges[1])) <= 1e-6:
+    if types == ["hinge", "hinge"] and concurrent and abs(float(portable.dot(hinges[0], hinges[1]))) <= 1e-6:
         return "universal"
-    if types == ["hinge"] * 3 and concurrent and abs(float(np.linalg.det(np.array(hinges)))) > 1e-6:
+    if types == ["hinge"] * 3 and concurrent and abs(float(portable.det(np.array(hinges)))) > 1e-6:
         return "ball"
-    if (types == ["hinge", "slide", "slide"] and np.linalg.norm(np.cross(*slides)) > 1e-6
-            and max(abs(float(hinges[0] @ axis)) for axis in slides) <= 1e-6):  # fmt: skip
+    if (types == ["hinge", "slide", "slide"] and portable.norm(np.cross(*slides)) > 1e-6
+            and max(abs(float(portable.dot(hinges[0], axis))) for axis in slides) <= 1e-6):  # fmt: skip
         return "planar"
     listed = ", ".join(f"{j.type} {j.name!r}" for j in joints)
     raise ValueError(

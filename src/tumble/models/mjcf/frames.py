@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ... import portable
 from ...rotation import matrix_to_quat, quat_from_axis_angle, quat_multiply
 
 __all__ = ["ORIENTATIONS", "orientation", "quat_z_to"]
@@ -21,12 +22,12 @@ _AXES = {"x": (1.0, 0.0, 0.0), "y": (0.0, 1.0, 0.0), "z": (0.0, 0.0, 1.0)}
 
 def quat_z_to(direction: np.ndarray) -> np.ndarray:
     """The shortest rotation taking the z axis onto ``direction`` (half a turn about x when they are opposite)."""
-    z = direction / np.linalg.norm(direction)
+    z = direction / portable.norm(direction)
     axis = np.cross((0.0, 0.0, 1.0), z)
-    s = float(np.linalg.norm(axis))
+    s = float(portable.norm(axis))
     if s < 1e-14:
         return np.array([1.0, 0.0, 0.0, 0.0]) if z[2] > 0 else np.array([0.0, 1.0, 0.0, 0.0])
-    return quat_from_axis_angle(axis / s, np.arctan2(s, z[2]))
+    return quat_from_axis_angle(axis / s, portable.arctan2(s, z[2]))
 
 
 def orientation(kind: str, values: np.ndarray, degrees: bool, eulerseq: str) -> np.ndarray:
@@ -37,14 +38,14 @@ def orientation(kind: str, values: np.ndarray, degrees: bool, eulerseq: str) -> 
     """
     scale = np.pi / 180.0 if degrees else 1.0
     if kind == "quat":
-        norm = np.linalg.norm(values)
+        norm = portable.norm(values)
         if norm == 0:
             raise ValueError("quat is zero")
         return values / norm
     if kind == "axisangle":
-        if np.linalg.norm(values[:3]) == 0:
+        if portable.norm(values[:3]) == 0:
             raise ValueError("the axis of axisangle is zero")
-        return quat_from_axis_angle(values[:3] / np.linalg.norm(values[:3]), values[3] * scale)
+        return quat_from_axis_angle(values[:3] / portable.norm(values[:3]), values[3] * scale)
     if kind == "euler":
         quat = np.array([1.0, 0.0, 0.0, 0.0])
         for axis, angle in zip(eulerseq, values, strict=True):
@@ -53,14 +54,14 @@ def orientation(kind: str, values: np.ndarray, degrees: bool, eulerseq: str) -> 
         return quat
     if kind == "xyaxes":
         x, y = values[:3], values[3:]
-        if np.linalg.norm(x) == 0:
+        if portable.norm(x) == 0:
             raise ValueError("the x axis of xyaxes is zero")
-        x = x / np.linalg.norm(x)
-        y = y - np.dot(x, y) * x
-        if np.linalg.norm(y) < 1e-14:
+        x = x / portable.norm(x)
+        y = y - portable.dot(x, y) * x
+        if portable.norm(y) < 1e-14:
             raise ValueError("the y axis of xyaxes is parallel to x")
-        y = y / np.linalg.norm(y)
+        y = y / portable.norm(y)
         return matrix_to_quat(np.column_stack([x, y, np.cross(x, y)]))
-    if np.linalg.norm(values) == 0:  # zaxis
+    if portable.norm(values) == 0:  # zaxis
         raise ValueError("zaxis is zero")
     return quat_z_to(values)

@@ -15,6 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from ... import mass as _mass
+from ... import portable
 from ...mass import MassProperties
 
 __all__ = ["VOLUME_TYPES", "bounded", "geom_area", "geom_mass_properties", "geom_volume",
@@ -90,7 +91,7 @@ def shell_mass_properties(kind: str, size: np.ndarray, mass: float) -> MassPrope
         # row k: the mean of x², y², z² over the faces normal to axis k (at ±side there, uniform across)
         mean_square = np.tile(side**2 / 3.0, (3, 1))
         np.fill_diagonal(mean_square, side**2)
-        second = pairs @ mean_square  # ∫ x², ∫ y², ∫ z²
+        second = portable.matvec(mean_square.T, pairs)  # ∫ x², ∫ y², ∫ z²
         moments = second.sum() - second
         return MassProperties(mass, np.zeros(3), np.diag(moments))
     side = rho * 4.0 * np.pi * r * h  # the tube of length 2h
@@ -114,4 +115,4 @@ def bounded(properties: MassProperties | None, boundmass: float, boundinertia: f
         return MassProperties(boundmass, np.zeros(3), boundinertia * np.eye(3))
     moments, axes = properties.principal()
     moments = np.maximum(moments, boundinertia)
-    return MassProperties(max(properties.mass, boundmass), properties.com, axes @ np.diag(moments) @ axes.T)
+    return MassProperties(max(properties.mass, boundmass), properties.com, portable.matmul(axes * moments, axes.T))

@@ -22,6 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import ConvexHull, QhullError
 
+from ... import portable
 from ...mass import MassProperties
 from ...rotation import matrix_to_quat
 
@@ -47,9 +48,9 @@ class MeshInertia:
     def principal_frame(self) -> tuple[np.ndarray, np.ndarray]:
         """``(quat, box)``: the principal axes (largest moment first, a proper rotation) and the half sizes of the
         uniform box with the same measure and moments: MuJoCo fits a primitive geom given a mesh to that box."""
-        moments, axes = np.linalg.eigh(self.inertia)
+        moments, axes = portable.eigh(self.inertia)
         moments, axes = moments[::-1], axes[:, ::-1]
-        if np.linalg.det(axes) < 0.0:
+        if portable.det(axes) < 0.0:
             axes[:, 2] = -axes[:, 2]
         a, b, c = moments / self.measure
         box = 0.5 * np.sqrt(np.maximum(6.0 * np.array([b + c - a, a + c - b, a + b - c]), 0.0))
@@ -68,7 +69,7 @@ def convex_hull_faces(vertices: np.ndarray) -> np.ndarray:
         raise ValueError(f"its vertices span no volume: no convex hull ({str(error).splitlines()[0]})") from None
     faces = hull.simplices.copy()
     a, b, c = (vertices[faces[:, k]] for k in range(3))
-    inward = np.einsum("ij,ij->i", np.cross(b - a, c - a), hull.equations[:, :3]) < 0.0
+    inward = portable.dot(np.cross(b - a, c - a), hull.equations[:, :3]) < 0.0
     faces[inward] = faces[inward][:, ::-1]
     return faces
 
@@ -86,7 +87,7 @@ def _pyramids(mode: str, area: np.ndarray, normal: np.ndarray, centre: np.ndarra
     """Each face's share: its pyramid's volume from ``apex`` (positive in legacy mode), or its area for a shell."""
     if mode == "shell":
         return area
-    volume = np.einsum("ij,ij->i", centre - apex, normal) * area / 3.0
+    volume = portable.dot(centre - apex, normal) * area / 3.0
     return np.abs(volume) if mode == "legacy" else volume
 
 
@@ -115,24 +116,25 @@ def mesh_inertia(vertices: np.ndarray, faces: np.ndarray, mode: str) -> MeshIner
         raise ValueError(f"its surface area is too small ({total_area:.3g} m²)")
     if mode == "exact" and (edge := _inconsistent_edge(faces, area)) is not None:
         raise ValueError(f"its faces are inconsistently wound (two faces walk the edge {edge[0]} -> {edge[1]})")
-    face_centroid = area @ centre / total_area
+    face_centroid = portable.weighted_sum(area, centre) / total_area
     share = _pyramids(mode, area, normal, centre, face_centroid)
     measure = float(share.sum())
     if measure < _MIN:
         if measure < 0.0:
             raise ValueError(f"its volume is negative ({measure:.3g} m³): the faces point inwards")
         raise ValueError(f"its volume is too small ({measure:.3g} m³); inertia='shell' spreads the mass on the surface")
-    com = share @ (0.75 * centre + 0.25 * face_centroid) / measure
+    com = portable.weighted_sum(share, 0.75 * centre + 0.25 * face_centroid) / measure
     # second pass: pyramids from the centre of mass (their volumes, recomputed, give the measure MuJoCo keeps)
     corners = corners - com
     area, normal, centre = _triangles(corners)
     share = _pyramids(mode, area, normal, centre, np.zeros(3))
     s = corners.sum(axis=1)
     weighted = corners * share[:, None, None]
-    second = weighted.reshape(-1, 3).T @ corners.reshape(-1, 3) + (s * share[:, None]).T @ s
+    rows = weighted.reshape(-1, 3)
+    second = portable.outer_sum(np.ones(len(rows)), rows, corners.reshape(-1, 3)) + portable.outer_sum(share, s, s)
     second /= 12.0 if mode == "shell" else 20.0
     inertia = np.trace(second) * np.eye(3) - second
-    moments = np.linalg.eigvalsh(inertia)
+    moments = portable.eigh(inertia)[0]
     if moments[0] <= 0.0:
         raise ValueError(f"its principal moments {moments.tolist()} are not all positive")
     a, b, c = moments

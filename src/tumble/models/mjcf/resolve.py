@@ -16,6 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ... import portable
 from ...mass import MassProperties
 from ...rotation import quat_multiply, quat_rotate, quat_to_matrix
 from ..description import (
@@ -214,9 +215,9 @@ def _joint(reader: _Reader, node: Node, childclass: str, is_top: bool) -> JointD
         raise node.error("a free joint can only be in a top-level body (a child of <worldbody>)")
     axis = _numbers(node, a, "axis", 3, [0.0, 0.0, 1.0])
     if kind in ("hinge", "slide"):
-        if np.linalg.norm(axis) < 1e-14:
+        if portable.norm(axis) < 1e-14:
             raise node.error(f"axis={a['axis']!r} is zero")
-        axis = axis / np.linalg.norm(axis)
+        axis = axis / portable.norm(axis)
     # angles (a hinge's or ball's range, a hinge's ref and springref) in the compiler's unit
     scale = np.pi / 180.0 if kind in ("hinge", "ball") and reader.compiler.degrees else 1.0
     stiffness = _numbers(node, a, "stiffness", (1, 2, 3), [0.0])
@@ -308,7 +309,7 @@ def _geom(reader: _Reader, node: Node, childclass: str) -> tuple[GeomDescription
             raise node.error(f"fromto places a capsule, cylinder, box or ellipsoid, not a {kind}")
         ends = _numbers(node, a, "fromto", 6)
         segment = ends[3:] - ends[:3]
-        length = float(np.linalg.norm(segment))
+        length = float(portable.norm(segment))
         if length < 1e-14:
             raise node.error(f"fromto={a['fromto']!r} has zero length")
         pos, quat = 0.5 * (ends[:3] + ends[3:]), quat_z_to(segment)
@@ -374,7 +375,7 @@ def _inertial(reader: _Reader, node: Node) -> MassProperties:
         tensor = np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]])
     elif "diaginertia" in a:
         rotation = quat_to_matrix(_frame_quat(reader, node, a))
-        tensor = rotation @ np.diag(_numbers(node, a, "diaginertia", 3)) @ rotation.T
+        tensor = portable.matmul(rotation * _numbers(node, a, "diaginertia", 3), rotation.T)
     else:
         raise node.error("inertial needs diaginertia or fullinertia")
     try:

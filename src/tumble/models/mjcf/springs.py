@@ -11,8 +11,7 @@ from __future__ import annotations
 
 from dataclasses import replace
 
-import numpy as np
-
+from ... import portable
 from ..description import ModelDescription
 
 __all__ = ["sized_springs"]
@@ -27,7 +26,7 @@ def sized_springs(model: ModelDescription) -> ModelDescription:
     from ..build import to_articulation
 
     articulation = to_articulation(model)  # it starts at qpos0
-    inverse = np.linalg.inv(articulation.mass_matrix(articulation.q))
+    inverse = portable.inverse(articulation.mass_matrix(articulation.q))
     dof, bodies = 0, []
     for body in model.bodies:
         joints = []

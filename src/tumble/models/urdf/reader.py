@@ -18,6 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ... import portable
 from ...mass import MassProperties
 from ...rotation import quat_from_axis_angle, quat_multiply
 from ..description import BodyDescription, GeomDescription, JointDescription, MeshDescription, ModelDescription
@@ -108,7 +109,7 @@ def _mass_properties(link: Node) -> MassProperties | None:
         raise inertia_node.error(f"link {link.attrib.get('name')!r}: a non-physical inertia: {error}") from None
     # MassProperties forgives 1 % of the trace (round-off of meshes); a tensor written by hand gets the last digits'
     # worth, as MuJoCo refuses these files (pybullet_data's mini_cheetah and TwoJointRobot fail it by 0.4-3 %)
-    moments = np.linalg.eigvalsh(tensor)
+    moments = portable.eigh(tensor)[0]
     if moments[0] + moments[1] < moments[2] - 1e-6 * moments.sum():
         raise inertia_node.error(f"link {link.attrib.get('name')!r}: a non-physical inertia: its principal moments "
                                  f"{np.array2string(moments, precision=6)} fail the triangle inequality "
@@ -203,7 +204,7 @@ def _joint(node: Node, links: dict[str, Node]) -> tuple[str, str, JointDescripti
         return ends[0], ends[1], description, pos, quat
     axis_node = _child(node, "axis")
     axis = np.array([1.0, 0.0, 0.0]) if axis_node is None else _numbers(axis_node, "xyz", 3)
-    norm = float(np.linalg.norm(axis))
+    norm = float(portable.norm(axis))
     if norm < 1e-12:
         raise axis_node.error(f"joint {name!r}: axis xyz={axis_node.attrib['xyz']!r} has no direction")
     joint_range = None

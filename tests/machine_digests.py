@@ -1,0 +1,116 @@
+"""Build scenes, run them, and print digests of what was built and where it went, as JSON: the probe of the test
+that every machine gives the same bits (``tests/analytic/test_machine_determinism.py``), which runs this in fresh
+processes under different BLAS kernels, libm variants and CPU targets and compares.
+
+    python tests/machine_digests.py CASE[@RATE] [CASE[@RATE] ...]
+
+A case without ``@RATE`` is only built (its model's digest); with one it also runs 2 s at that rate (Hz). Each entry
+of the output maps ``CASE`` to the model's field digests and ``CASE@RATE`` to the final ``State.digest()`` (or
+``"error: <message>"``).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import json
+import os
+import sys
+
+import numpy as np
+
+import tumble
+from tumble import scene_file, scenes
+from tumble.errors import SimulationError
+from tumble.shapes import ConvexHull
+
+DURATION = 2.0
+
+
+def hull_pile(count: int = 24, seed: int = 3) -> tumble.World:
+    """Random convex hulls (each from 8 to 20 normal points) dropped onto a plane: hull mass properties, hull
+    collision and a pile's chaos."""
+    world = tumble.World()
+    world.add_static(tumble.Plane())
+    rng = np.random.default_rng(seed)
+    for k in range(count):
+        points = rng.normal(size=(int(rng.integers(8, 21)), 3)) * rng.uniform(0.04, 0.12, size=3)
+        world.add_body(
+            ConvexHull(points),
+            density=float(rng.uniform(300.0, 3000.0)),
+            position=(rng.uniform(-0.3, 0.3), rng.uniform(-0.3, 0.3), 0.3 + 0.15 * k),
+            orientation=tumble.rotation.quat_from_rotvec(rng.normal(size=3)),
+        )
+    return world
+
+
+def ant() -> tumble.World:
+    """Gymnasium's ant (MJCF) on its floor: a model file's inertias, frames and joints."""
+    import warnings
+
+    import gymnasium
+
+    path = os.path.join(os.path.dirname(gymnasium.__file__), "envs", "mujoco", "assets", "ant.xml")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return tumble.load_mjcf(path)
+
+
+def _shipped(name: str):
+    return lambda: scene_file.load(scene_file.shipped_scene(name)).world
+
+
+CASES = {
+    "mixed_pile": lambda: scenes.mixed_pile(40),
+    "hull_pile": hull_pile,
+    "ant": ant,
+    **{
+        name: _shipped(name)
+        for name in (
+            "flagship",
+            "ragdoll_stairs",
+            "robot_arm",
+            "dzhanibekov",
+            "four_bar",
+            "quadrotor_figure_eight_wind",
+        )
+    },
+}
+
+
+def _array_digests(prefix: str, value, out: dict) -> None:
+    """A short digest of every array in ``value`` (a dataclass, tuple or array), keyed by its field path."""
+    if dataclasses.is_dataclass(value):
+        for f in dataclasses.fields(value):
+            _array_digests(f"{prefix}.{f.name}", getattr(value, f.name), out)
+    elif isinstance(value, np.ndarray) and value.dtype != object:
+        out[prefix] = hashlib.sha256(np.ascontiguousarray(value).tobytes()).hexdigest()[:16]
+
+
+def model_digests(world: tumble.World) -> dict:
+    out: dict = {}
+    _array_digests("model", world.model, out)
+    _array_digests("state", world.state, out)
+    return out
+
+
+def run(case: str) -> object:
+    name, _, rate = case.partition("@")
+    world = CASES[name]()
+    if not rate:
+        return model_digests(world)
+    try:
+        with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+            world.simulate(DURATION, 1.0 / float(rate), record_every=max(1, round(float(rate))))
+    except SimulationError as error:
+        return f"error: {error}"
+    return world.state.digest()
+
+
+def main(argv: list[str]) -> int:
+    print(json.dumps({case: run(case) for case in argv}))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
