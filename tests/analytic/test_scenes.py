@@ -85,6 +85,15 @@ def test_a_mixed_pile_stays_in_the_mesh_bowl(seed):
     assert kept > 0.9
 
 
+@pytest.mark.slow
+@pytest.mark.parametrize("rate", [60.0, 240.0])
+@pytest.mark.parametrize("seed", range(4, 14))
+def test_mixed_piles_of_40_to_60_bodies_stay_in_the_mesh_bowl_at_60_and_240_hz(seed, rate):
+    below, kept = mixed_pile_depths(seed, rate, count=40 + 2 * (seed - 4))
+    assert below < 0.01
+    assert kept > 0.9
+
+
 def test_a_row_of_dominoes_topples_to_the_last():
     world = scenes.dominoes(20)
     world.simulate(3.0, DT)

@@ -425,6 +425,24 @@ def test_sphere_on_one_facet_up_the_side_of_a_mesh_bowl():
     np.testing.assert_allclose(m.point[0], nearest - 0.005 * n, atol=1e-12)  # measured 2e-16
 
 
+def test_a_shape_behind_an_open_meshs_rim_is_not_dragged_in_through_it():
+    """Issue 44: a box outside the bowl's rim, below it (behind the outermost ring's triangles), touches their back.
+    A one-sided mesh never pushes out through its back, but only a shape over a triangle is pushed out along the
+    face normal: this one lies beside the triangles, and pushing it along their normal pulled it in through the wall
+    (6 cm under the surface, in a pile). A shape over the triangles, sunk as deep, still comes out the front."""
+    mesh = bowl(rings=4, segments=12, top_degrees=60.0)
+    rim = mesh.vertices[-12]  # a vertex of the rim, at x > 0, y = 0
+    outside = rim + np.array([0.03, 0.0, -0.1])  # beyond the rim and below it, through the wall's back
+    assert collide(Box((0.2, 0.2, 0.2)), outside, mesh, (0, 0, 0)).count == 0  # was 25 cm deep, pulled inwards
+    # The same box moved over the last ring's triangles, as far behind their plane: pushed out the front.
+    a, b, c = mesh.vertices[mesh.faces[-2]]
+    n = np.cross(b - a, c - a)
+    n /= np.linalg.norm(n)
+    over = (a + b + c) / 3.0 - 0.05 * n
+    m = collide(Box((0.2, 0.2, 0.2)), over, mesh, (0, 0, 0))
+    assert m.count >= 1 and m.normal @ n < -0.9 and m.separation.min() < -0.05
+
+
 def test_mesh_candidate_buffer_squeezes_without_losing_the_corners():
     """A large box over a fine grid produces more candidates than the buffer holds; the box corners survive."""
     n = 21

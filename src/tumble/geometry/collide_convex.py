@@ -48,7 +48,7 @@ import numpy as np
 
 from .. import elementary
 from .._jit import inline, kernel
-from ..math3d import add, add_scaled, cross, dot, quat_rotate, quat_rotate_inv, scale, sub
+from ..math3d import add, add_scaled, cross, dot, load4, quat_rotate, quat_rotate_inv, scale, sub
 from ..shapes import ShapeType
 from .gjk import core_proxy, core_radius, core_size, proxy_contact, support_world
 from .manifold import MAX_POINTS
@@ -948,7 +948,12 @@ def collide_convex_trimesh(geom, shape_a, pos_a, quat_a, shape_b, pos_b, quat_b,
         n_face = quat_rotate(quat_b, _row(face_normal, f))
         if dot(n, n_face) > 0.0:
             # Meshes are one-sided: a shape sunk deep (or straddling the triangle) is never pushed out through the
-            # back, as the least-depth axis of a thin triangle may say; it goes back out along the face normal.
+            # back, as the least-depth axis of a thin triangle may say; it goes back out along the face normal. Only
+            # a shape over the triangle, though: one beside it (beyond an open mesh's rim, or past an inner edge,
+            # where the neighbour holds it) would be dragged through the mesh sideways (issue 44: at a bowl's rim, a
+            # hull outside and below it was pulled in through the wall, 6 cm under the surface).
+            if not _over_triangle(geom, shape_a, pos_a, quat_a, pos_b, quat_b, vertex_local, i0, i1, i2, n_face):
+                continue
             v0 = add(pos_b, quat_rotate(quat_b, _row(vertex_local, i0)))
             k = _front_face_contact(geom, shape_a, pos_a, quat_a, v0, n_face, margin, tri_point, tri_sep, tri_id)
             if k == 0:
@@ -968,6 +973,24 @@ def collide_convex_trimesh(geom, shape_a, pos_a, quat_a, shape_b, pos_b, quat_b,
         return 0
     return _merge_mesh_contacts(cand_point, cand_normal, cand_sep, cand_id, cand_face, m, margin, normal, point,
                                 separation, feature)  # fmt: skip
+
+
+@inline
+def _over_triangle(geom, shape_a, pos_a, quat_a, pos_b, quat_b, vertex_local, i0, i1, i2, n_face):
+    """Whether shape A's centre (its bounds' centre) lies over the triangle ``(i0, i1, i2)``: inside the prism its
+    edges sweep along its normal ``n_face`` (counter-clockwise about it)."""
+    # The bounds' centre is stored in the body frame: from the shape's origin there, turned into the shape's frame.
+    offset = sub(_row(geom.shape_aabb_center_local, shape_a), _row(geom.shape_pos_local, shape_a))
+    local = quat_rotate_inv(load4(geom.shape_quat_local, shape_a), offset)
+    c = add(pos_a, quat_rotate(quat_a, local))
+    v0 = add(pos_b, quat_rotate(quat_b, _row(vertex_local, i0)))
+    v1 = add(pos_b, quat_rotate(quat_b, _row(vertex_local, i1)))
+    v2 = add(pos_b, quat_rotate(quat_b, _row(vertex_local, i2)))
+    return (
+        dot(cross(sub(v1, v0), sub(c, v0)), n_face) >= 0.0
+        and dot(cross(sub(v2, v1), sub(c, v1)), n_face) >= 0.0
+        and dot(cross(sub(v0, v2), sub(c, v2)), n_face) >= 0.0
+    )
 
 
 @inline
