@@ -317,7 +317,9 @@ def _diagonal(mass: float, moments, com=(0.0, 0.0, 0.0)) -> MassProperties:
         inertia = np.diag(np.asarray(moments, dtype=np.float64))
     if not np.isfinite(inertia).all():
         raise _OutOfRange(f"the moments of inertia {np.diag(inertia).tolist()} overflow: give a smaller mass or size")
-    return MassProperties._trusted(mass, np.asarray(com, dtype=np.float64), inertia)
+    return MassProperties._trusted(
+        mass, np.asarray(com, dtype=np.float64), inertia, _readonly(np.sort(np.diag(inertia)))
+    )
 
 
 @_named_arguments

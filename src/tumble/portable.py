@@ -148,8 +148,12 @@ def eigh(m) -> tuple[np.ndarray, np.ndarray]:
     zeroing one off-diagonal entry, until none is left above round-off; the rotation of each step as in Press et
     al., Numerical Recipes (3rd ed.), §11.1, eqs. 11.1.8-11.1.18, which keeps its angle at most π/4.
     """
-    a = [[float(x) for x in row] for row in np.asarray(m, np.float64)]
-    n = len(a)
+    m = np.asarray(m, np.float64)
+    n = m.shape[0]
+    if np.count_nonzero(m - np.diag(np.diag(m))) == 0:  # diagonal already (a primitive's inertia): sort it
+        order = np.argsort(np.diag(m), kind="stable")
+        return np.diag(m)[order], np.eye(n)[:, order]
+    a = m.tolist()
     v = [[1.0 if i == j else 0.0 for j in range(n)] for i in range(n)]
     pairs = [(p, q) for p in range(n) for q in range(p + 1, n)]
     for _ in range(_JACOBI_SWEEPS):
@@ -213,10 +217,14 @@ def _elementwise(function, y, x, out):
             out[i] = elementary.atan(y[i])
 
 
-def _apply(function: int, y, x=0.0):
-    y, x = np.broadcast_arrays(np.asarray(y, np.float64), np.asarray(x, np.float64))
+def _apply(function: int, y, x=None):
+    y = np.asarray(y, dtype=np.float64, order="C")  # 0-d stays 0-d (ascontiguousarray makes it 1-d)
+    if x is None:
+        x = y  # not read
+    else:
+        y, x = (np.asarray(a, order="C") for a in np.broadcast_arrays(y, np.asarray(x, np.float64)))
     out = np.empty(y.shape)
-    _elementwise(function, np.ascontiguousarray(y).reshape(-1), np.ascontiguousarray(x).reshape(-1), out.reshape(-1))
+    _elementwise(function, y.reshape(-1), x.reshape(-1), out.reshape(-1))
     return out if out.ndim else out[()]
 
 
