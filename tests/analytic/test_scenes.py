@@ -3,11 +3,15 @@ settle without sinking, rows topple, ramps sort by friction, bullets stop at the
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 import pytest
 
-from tumble import scenes
+from overlap_depths import overlap_depths
+from tumble import World, scenes
 from tumble.rotation import quat_to_matrix
+from tumble.shapes import Box, ConvexHull, Cylinder, Sphere
 
 DT = 1 / 60
 
@@ -38,9 +42,12 @@ def test_the_ten_box_tower_falls_asleep_standing():
     assert top.sleeping
 
 
-@pytest.mark.slow
-def test_the_1000_box_pile_settles_without_sinking_into_the_ground():
-    world = scenes.box_pile(1000)
+# Every pile over several seeds, never one lucky trajectory (issue 44): seeds 0-2 in make test, 3-12 in make
+# test-slow. Measured over seeds 0-12: the lowest corner 0.48-0.77 mm into the ground, the deepest contact 1.8-2.9 mm,
+# the fastest awake box 11-27 mm/s.
+@pytest.mark.parametrize("seed", [*range(3), *(pytest.param(seed, marks=pytest.mark.slow) for seed in range(3, 13))])
+def test_the_1000_box_pile_settles_without_sinking_into_the_ground(seed):
+    world = scenes.box_pile(1000, seed=seed)
     world.simulate(5.0, DT)
     assert lowest_corner_heights(world, 0.2).min() > -0.01  # issue: no box more than 1 cm into the ground
     assert -world.contacts().separation.min() < 5e-3  # benchmark target: penetration < 5 mm
@@ -130,3 +137,90 @@ def test_the_newtons_cradle_scene_passes_the_momentum_to_the_last_ball():
     world.simulate(1.0, DT)
     assert world.body("striker").velocity[0] == pytest.approx(0.0, abs=1e-9)
     assert world.body("last").velocity[0] == pytest.approx(2.0, rel=1e-9)
+
+
+@functools.cache
+def mixed_drop_depths(seed: int, rate: float) -> tuple[float, float, float]:
+    """``scenes.mixed_drop(60, seed)`` stepped at ``rate`` Hz for 3 s: the deepest overlap into the ground and between
+    bodies [m], and the lowest height a centre of mass reached [m] (``overlap_depths``)."""
+    return overlap_depths(scenes.mixed_drop(60, seed), rate, 3.0)
+
+
+# 60 shapes dropped from 5-6.2 m onto the ground, landing on each other at 10-11 m/s: none passes through the ground
+# or sinks its centre into it, and no contact goes deeper than was measured when this test was written (issue 44;
+# 60 Hz over seeds 1-13: into the ground 4.2-8.4 cm, between bodies 5.9-10.8 cm; 240 Hz over seeds 1-10: 0.5-2.1 cm
+# and 2.1-3.9 cm).
+DROP_BOUNDS = {60.0: (0.10, 0.12), 240.0: (0.03, 0.05)}  # (into the ground, between bodies) [m]
+
+
+@pytest.mark.parametrize(
+    ("seed", "rate"),
+    [
+        *((seed, 60.0) for seed in range(1, 4)),
+        *(pytest.param(seed, 60.0, marks=pytest.mark.slow) for seed in range(4, 14)),
+        *(pytest.param(seed, 240.0, marks=pytest.mark.slow) for seed in range(1, 11)),
+    ],
+)
+def test_shapes_dropped_on_the_ground_at_10_m_per_s_stay_out_of_it(seed, rate):
+    into_ground, between_bodies, lowest = mixed_drop_depths(seed, rate)
+    assert lowest > -0.01  # as for the bowl: no centre 1 cm under the surface (measured: 0.5 cm above it at least)
+    assert into_ground < DROP_BOUNDS[rate][0]
+    assert between_bodies < DROP_BOUNDS[rate][1]
+
+
+# Issue 44's target for the deepest transient overlap, not met yet: 5 cm at 60 Hz (measured 8.4 cm over seeds 1-3).
+# The contact geometry is found once per step and held for its substeps; bodies that slide or turn by centimetres
+# within a step close gaps the step's speculative points do not see (docs/contact.md, "Deep overlaps in piles").
+@pytest.mark.xfail(strict=True, reason="issue 44, part 3: deep transient overlaps at 60 Hz (docs/contact.md)")
+def test_the_deepest_overlap_of_shapes_dropped_at_10_m_per_s_is_at_most_5_cm_at_60_hz():
+    assert max(max(mixed_drop_depths(seed, 60.0)[:2]) for seed in range(1, 4)) <= 0.05
+
+
+def slide_over_the_rim(shape, azimuth: float, speed: float, rate: float) -> tuple[float, int, int, float]:
+    """``shape`` let go 0.15 m over the bowl's floor (0.3 m out, at ``azimuth``) moving out at ``speed`` [m/s]: it
+    lands, slides up the wall, over the open rim (1.5 m out) and falls off outside. Returns, for the steps it
+    touched the bowl with its centre past 1.35 m out (by the rim): the deepest overlap [m], how many there were and
+    how many of them turned the contact normal by more than 120° from the last step's; and how far out it ends [m]."""
+    world = World()
+    world.add_static(scenes.bowl_mesh(), name="bowl")  # z = 0.6 (r / 1.5)², open at r = 1.5
+    out = np.array([np.cos(azimuth), np.sin(azimuth), 0.0])
+    position = 0.3 * out + (0.0, 0.0, 0.6 * (0.3 / 1.5) ** 2 + 0.15)
+    body = world.add_body(shape, density=800.0, position=position, velocity=speed * out)
+    deepest, touching, turns, last = 0.0, 0, 0, None
+    for _ in range(round(1.5 * rate)):
+        world.step(1.0 / rate)
+        contacts = world.contacts()
+        touched = contacts.separation <= 0.0
+        if not touched.any() or np.hypot(*body.position[:2]) < 1.35:
+            last = None
+            continue
+        from_bowl = (contacts.normal * np.where(contacts.body_a == body.index, -1.0, 1.0)[:, None])[touched]
+        deepest = max(deepest, -contacts.separation.min())
+        touching += 1
+        if last is not None and (last @ from_bowl.T).min() < -0.5:
+            turns += 1
+        last = from_bowl
+    return deepest, touching, turns, float(np.hypot(*body.position[:2]))
+
+
+# The bowl's open rim (issue 44): sliding over it, a body keeps a contact normal that points out of the bowl's front,
+# step after step, and stays out of the wall; in piles before issue 44 a body at the rim had its normal flip and its
+# separation jump between +3 and -9 cm. Measured at 8 m/s: no turn, at most 0.73 cm deep by the rim (a capsule
+# leaves out: it tumbles off the floor and flies over the rim).
+@pytest.mark.parametrize("rate", [60.0, 240.0])
+@pytest.mark.parametrize(
+    "shape",
+    [
+        Box((0.14, 0.1, 0.08)),
+        Sphere(0.08),
+        Cylinder(0.06, 0.1),
+        ConvexHull(np.random.default_rng(1).normal(size=(12, 3)) * 0.08),
+    ],
+    ids=["box", "sphere", "cylinder", "hull"],
+)
+def test_a_body_sliding_over_the_bowls_open_rim_keeps_its_contact_normal(shape, rate):
+    for azimuth in (0.0, 0.13):  # along a radial edge of the mesh, and across the middle of its triangles
+        deepest, touching, turns, end = slide_over_the_rim(shape, azimuth, 8.0, rate)
+        assert touching >= 3 and end > 1.6  # it slid over the rim, and off
+        assert turns == 0
+        assert deepest < 0.01
