@@ -92,11 +92,25 @@ def test_a_mixed_pile_stays_in_the_mesh_bowl(seed):
     assert kept > 0.9
 
 
+# Seed 19 at 60 Hz: a cylinder landing in the pile has its centre 1.01 cm under the surface for one frame (about 6 cm
+# into the bowl) and is pushed back out the next: a transient overlap of issue 44, part 3, not a fall through.
+_TRANSIENT_AT_SEED_19 = pytest.mark.xfail(strict=True, reason="issue 44, part 3: a 6 cm transient overlap at 60 Hz")
+
+
 @pytest.mark.slow
-@pytest.mark.parametrize("rate", [60.0, 240.0])
-@pytest.mark.parametrize("seed", range(4, 14))
+@pytest.mark.parametrize(
+    ("seed", "rate"),
+    [
+        *((seed, rate) for seed in range(4, 14) for rate in (60.0, 240.0)),
+        *(
+            pytest.param(seed, 60.0, marks=_TRANSIENT_AT_SEED_19) if seed == 19 else (seed, 60.0)
+            for seed in range(14, 21)
+        ),
+    ],
+)
 def test_mixed_piles_of_40_to_60_bodies_stay_in_the_mesh_bowl_at_60_and_240_hz(seed, rate):
-    below, kept = mixed_pile_depths(seed, rate, count=40 + 2 * (seed - 4))
+    """Seeds 1-20 at 60 Hz (1-3 above), 4-13 at 240 Hz."""
+    below, kept = mixed_pile_depths(seed, rate, count=40 + 2 * ((seed - 4) % 10))
     assert below < 0.01
     assert kept > 0.9
 
