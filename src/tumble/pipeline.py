@@ -13,8 +13,12 @@ Bodies with contacts (the soft step of DESIGN.md):
     match_warm_start      state.contact_*        -> scratch.warm_*         (geometry/narrow_phase.py)
     wake_touched          manifolds              -> state.body_sleeping    (dynamics/islands.py)
     prepare_contacts      manifolds, bodies      -> scratch.rows           (dynamics/contact_solver.py)
+    contact_passes        manifolds, velocities  -> how often each pair finds its contacts in the step (narrow_phase.py)
     run_substeps          integrate v, ball impacts, warm start, solve, integrate x, relax: joints
-                          (dynamics/joint_solver.py), then contacts (dynamics/contact_solver.py)
+                          (dynamics/joint_solver.py), then contacts (dynamics/contact_solver.py); between runs of
+                          them, the fast pairs' contacts found again at the poses then:
+      collide_each        listed pairs           -> fresh manifolds        (geometry/narrow_phase.py)
+      rebase_contacts     fresh manifolds        -> their manifolds, rows  (dynamics/contact_solver.py)
     apply_restitution     rows                   -> velocities             (dynamics/contact_solver.py)
     limit_to_impact       pairs, poses           -> poses of fast bodies   (geometry/toi.py)
     store impulses        rows                   -> state.contact_*        (here)
@@ -31,12 +35,12 @@ from __future__ import annotations
 import numpy as np
 
 from .dynamics.actuation import ActuatorArrays, advance_motors
-from .dynamics.contact_solver import apply_restitution, prepare_contacts
+from .dynamics.contact_solver import apply_restitution, prepare_contacts, rebase_contacts
 from .dynamics.integrate import Recording, advance_free_bodies
 from .dynamics.islands import update_sleep, wake_touched
 from .dynamics.substep import run_substeps, to_angular_momentum, to_angular_velocity
 from .geometry.broad_phase import find_pairs, update_aabbs
-from .geometry.narrow_phase import collide_pairs, match_warm_start
+from .geometry.narrow_phase import allocate_manifolds, collide_each, collide_pairs, contact_passes, match_warm_start
 from .geometry.toi import limit_to_impact
 from .inputs import Inputs
 from .model import Model
@@ -258,34 +262,52 @@ def contact_step(
     scratch.joint_force_total[:] = 0.0
     scratch.joint_moment_total[:] = 0.0
     scratch.joint_step = dt
-    run_substeps(
-        bodies,
-        moving,
-        inv_mass,
-        model.body_gravity,
-        inputs.body_force,
-        inputs.body_torque,
-        acts,
-        rows,
-        count,
-        inv_inertia_world,
-        state.body_pos,
-        state.body_quat,
-        pos0,
-        quat0,
-        state.body_linvel,
-        angvel,
-        h,
-        substeps,
-        settings.contact_push_max,
-        settings.restitution_threshold,
-        model.joints if model.joint_count > 0 else None,  # None: no joint solver compiled or run
-        state.joint_impulses,
-        settings.joint_hertz,
-        settings.joint_damping_ratio,
-        scratch.joint_force_total,
-        scratch.joint_moment_total,
-    )
+
+    def substeps_between(first: int, last: int) -> None:
+        run_substeps(
+            bodies,
+            moving,
+            inv_mass,
+            model.body_gravity,
+            inputs.body_force,
+            inputs.body_torque,
+            acts,
+            rows,
+            count,
+            inv_inertia_world,
+            state.body_pos,
+            state.body_quat,
+            pos0,
+            quat0,
+            state.body_linvel,
+            angvel,
+            h,
+            first,
+            last,
+            settings.contact_push_max,
+            settings.restitution_threshold,
+            model.joints if model.joint_count > 0 else None,  # None: no joint solver compiled or run
+            state.joint_impulses,
+            settings.joint_hertz,
+            settings.joint_damping_ratio,
+            scratch.joint_force_total,
+            scratch.joint_moment_total,
+        )
+
+    # Fast pairs find their contacts again within the step (contact_passes); each pair by its own motion only, so a
+    # batch's copies step as separate worlds would.
+    passes = np.empty(count, dtype=np.int64)
+    if substeps > 1 and contact_passes(geom.shape_body, geom.shape_aabb_center_local, geom.shape_aabb_half_local,
+                                       moving, manifolds.shape_a, manifolds.shape_b, count, state.body_linvel, angvel,
+                                       dt, passes) > 1:  # fmt: skip
+        first = 0
+        for last, listed in _pass_boundaries(passes, substeps):
+            substeps_between(first, last)
+            _find_again(model, state, settings, scratch, listed, (substeps - last) * h, inv_mass, pos0, quat0)
+            first = last
+        substeps_between(first, substeps)
+    else:
+        substeps_between(0, substeps)
     apply_restitution(rows, count, inv_mass, inv_inertia_world, state.body_pos, state.body_quat, pos0, quat0,
                       state.body_linvel, angvel, settings.restitution_threshold)  # fmt: skip
     # Fast bodies that would have passed into static geometry stop at their first touch (unless jointed).
@@ -315,6 +337,27 @@ def contact_step(
             scratch.island_min_time,
         )
     to_angular_momentum(bodies, state.body_quat, angvel, state.body_angmom)
+
+
+def _pass_boundaries(passes: np.ndarray, substeps: int):
+    """``(k, rows)``: before substep ``k``, the rows whose contacts are found again, ``passes[m]`` equal runs of the
+    substeps for row ``m`` (as equal as whole substeps allow)."""
+    k = np.arange(1, substeps)
+    starts = (k * passes[:, None]) // substeps > ((k - 1) * passes[:, None]) // substeps
+    for column in np.flatnonzero(starts.any(axis=0)):
+        yield int(k[column]), np.flatnonzero(starts[:, column])
+
+
+def _find_again(model, state, settings, scratch, listed, remaining, inv_mass, pos0, quat0) -> None:
+    """The contacts of manifolds ``listed`` found again at the poses now, into their rows (``remaining``: the time
+    left in the step, which the speculative margin looks ahead)."""
+    manifolds, angvel = scratch.manifolds, scratch.body_angvel
+    fresh = allocate_manifolds(listed.shape[0])
+    collide_each(model.geometry, state.body_pos, state.body_quat, state.body_linvel, angvel,
+                 manifolds.shape_a[listed], manifolds.shape_b[listed], settings.speculative_distance, remaining,
+                 fresh)  # fmt: skip
+    rebase_contacts(listed, fresh, manifolds, scratch.rows, inv_mass, scratch.body_inv_inertia_world, state.body_pos,
+                    state.body_quat, pos0, quat0, state.body_linvel, angvel)  # fmt: skip
 
 
 def _store_impulses(state: State, manifolds, rows, count: int) -> None:

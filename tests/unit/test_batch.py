@@ -10,7 +10,7 @@ import pytest
 
 import tumble
 from compiled import compiled_only
-from tumble import Batch
+from tumble import Batch, pipeline
 from tumble import mass as tm
 from tumble.dynamics import integrate
 
@@ -29,14 +29,14 @@ def _spinning(k: int, *, gravity=(0.0, 0.0, -9.81), integrator="auto") -> tumble
     return world
 
 
-def _pile(k: int, *, gravity=(0.0, 0.0, -9.81), friction=0.5, restitution=0.0) -> tumble.World:
-    """Three boxes dropped on a plane and a sphere thrown at them (speed depends on ``k``)."""
+def _pile(k: int, *, gravity=(0.0, 0.0, -9.81), friction=0.5, restitution=0.0, throw=2.0) -> tumble.World:
+    """Three boxes dropped on a plane and a sphere thrown at them (at ``throw + k`` m/s)."""
     world = tumble.World(gravity=gravity)
     world.add_static(tumble.Plane(), friction=friction, restitution=restitution)
     for level in range(3):
         world.add_body(tumble.Box((0.5, 0.5, 0.5)), mass=1.0, position=(0.05 * level, 0, 0.3 + 0.55 * level),
                        friction=friction, restitution=restitution)  # fmt: skip
-    world.add_body(tumble.Sphere(0.2), mass=0.5, position=(-2, 0, 0.5), velocity=(2 + k, 0, 1),
+    world.add_body(tumble.Sphere(0.2), mass=0.5, position=(-2, 0, 0.5), velocity=(throw + k, 0, 1),
                    angular_velocity=(0, k, 0), friction=friction, restitution=restitution)  # fmt: skip
     return world
 
@@ -102,6 +102,24 @@ def test_copies_with_contacts_equal_separate_worlds_bit_for_bit(threads):
             world.step(1 / 60)
     _assert_copies_equal(batch, worlds)
     assert not np.array_equal(batch.state.body_pos[0], batch.state.body_pos[4])  # the copies did differ
+
+
+@compiled
+def test_copies_whose_fast_pairs_find_contacts_again_within_steps_equal_separate_worlds(monkeypatch):
+    """A pair that closes fast finds its contacts again within the step by its own motion only (issue 44), so a
+    copy's fast sphere changes nothing in the copies beside it."""
+    found_again = []
+    find_again = pipeline._find_again
+    monkeypatch.setattr(pipeline, "_find_again", lambda *args: found_again.append(1) or find_again(*args))
+    worlds = [_pile(k, throw=2.0 if k % 2 == 0 else 30.0) for k in range(5)]
+    batch = _batch_of(worlds)
+    batch.step(1 / 60, steps=60)
+    within_batch = len(found_again)
+    for world in worlds:
+        for _ in range(60):
+            world.step(1 / 60)
+    _assert_copies_equal(batch, worlds)
+    assert within_batch > 0 and len(found_again) > within_batch  # the fast spheres' pairs did find theirs again
 
 
 @compiled  # the reset test's chains run the batch's joint kernels as plain Python

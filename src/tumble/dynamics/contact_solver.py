@@ -1,7 +1,8 @@
 """Contact solver: soft step (soft contact constraints, substeps, relax, restitution).
 
 The scheme of Box2D v3 / Box3D / Rapier (E. Catto, "Solver2D", 2024): each step finds contacts once, then
-runs ``substeps`` small steps of ``h = dt / substeps``. In every substep the velocities are integrated, the
+runs ``substeps`` small steps of ``h = dt / substeps`` (pairs that close or turn fast find theirs again between
+substeps: :func:`rebase_contacts`). In every substep the velocities are integrated, the
 impulses of the last substep are re-applied (warm start), the contact constraints are solved once by
 sequential impulses with a *soft* position bias (a spring of ``contact_hertz`` and damping ratio, see
 ``softness.py``), the positions are integrated, and a relax pass solves the constraints again without bias
@@ -66,7 +67,14 @@ SUBSTEP_RATE_PER_CONTACT_HERTZ = 8.0
 # hold the interpreter uninterruptibly for hours (a step of 1e6 s needed 4.8e8 substeps, half an hour for one box).
 MAX_CONTACT_SUBSTEPS = 2**16
 
-__all__ = ["ContactRows", "SolverSettings", "prepare_contacts", "solve_contacts", "warm_start_contacts"]
+__all__ = [
+    "ContactRows",
+    "SolverSettings",
+    "prepare_contacts",
+    "rebase_contacts",
+    "solve_contacts",
+    "warm_start_contacts",
+]
 
 
 class SolverSettings(NamedTuple):
@@ -245,6 +253,100 @@ def prepare_contacts(
             rows.relative_velocity[m, j] = dot(_relative_velocity(va, wa, ra, vb, wb, rb), n)
         rows.sweeps[m] = 1
         for j in range(manifolds.point_count[m]):
+            if rows.relative_velocity[m, j] < -IMPACT_SPEED:
+                rows.sweeps[m] = IMPACT_SWEEPS
+
+
+@kernel
+def rebase_contacts(listed, fresh, manifolds, rows, inv_mass, inv_inertia_world, pos, quat, pos0, quat0, linvel,
+                    angvel):  # fmt: skip
+    """Put the contacts found again within the step into their rows: ``fresh[i]``, found at the bodies' poses now,
+    replaces manifold and row ``listed[i]``.
+
+    The solver measures every point from the step's start (:func:`_arms_now`), so the new points are written as
+    the anchors and separation that give, at the poses now, the arms to the new point and its new separation; from
+    here on they follow the bodies as the others do. A point with the same feature as one of the old keeps that
+    point's impulses (the warm start of the next substep, the step's totals, whether it pushed, its approach speed
+    for restitution); friction impulses turn onto the new tangents. A new point starts from nothing, with the
+    approach speed it has now. Writes: manifolds and rows ``listed``.
+    """
+    old_feature = np.zeros(MAX_POINTS, np.int64)
+    old_normal = np.zeros(MAX_POINTS)
+    old_tangent = np.zeros((MAX_POINTS, 3))
+    old_max = np.zeros(MAX_POINTS)
+    old_total = np.zeros(MAX_POINTS)
+    old_total_tangent = np.zeros((MAX_POINTS, 3))
+    old_velocity = np.zeros(MAX_POINTS)
+    for i in range(listed.shape[0]):
+        m = listed[i]
+        a, b, ma, ia, mb, ib, va, wa, vb, wb, dx_a, dq_a, dx_b, dq_b, weight_b = _load_pair(
+            rows, m, inv_mass, inv_inertia_world, pos, quat, pos0, quat0, linvel, angvel
+        )
+        t1_old, t2_old = load3(rows.tangent1, m), load3(rows.tangent2, m)
+        old_count = rows.point_count[m]
+        for j in range(old_count):
+            old_feature[j] = manifolds.feature[m, j]
+            old_normal[j] = rows.normal_impulse[m, j]
+            old_max[j] = rows.max_normal_impulse[m, j]
+            old_total[j] = rows.total_normal_impulse[m, j]
+            old_velocity[j] = rows.relative_velocity[m, j]
+            tangent = add(scale(t1_old, rows.tangent_impulse[m, j, 0]), scale(t2_old, rows.tangent_impulse[m, j, 1]))
+            total = add(scale(t1_old, rows.total_tangent_impulse[m, j, 0]),
+                        scale(t2_old, rows.total_tangent_impulse[m, j, 1]))  # fmt: skip
+            for c in range(3):
+                old_tangent[j, c], old_total_tangent[j, c] = tangent[c], total[c]
+        rolling = add(scale(t1_old, rows.rolling_impulse[m, 0]), scale(t2_old, rows.rolling_impulse[m, 1]))
+        count = fresh.point_count[i]
+        if count == 0:  # now apart by more than the margin: nothing to hold for the rest of the step
+            manifolds.point_count[m] = rows.point_count[m] = 0
+            rows.rolling_impulse[m, 0] = rows.rolling_impulse[m, 1] = 0.0
+            continue
+        n = load3(fresh.normal, i)
+        t1, t2 = tangent_basis(n)
+        for c in range(3):
+            manifolds.normal[m, c] = rows.normal[m, c] = n[c]
+            rows.tangent1[m, c], rows.tangent2[m, c] = t1[c], t2[c]
+        manifolds.point_count[m] = rows.point_count[m] = count
+        if rows.rolling[m] > 0.0:
+            rows.rolling_mass[m, 0] = _inverse_angular_mass(ia, ib, t1)
+            rows.rolling_mass[m, 1] = _inverse_angular_mass(ia, ib, t2)
+        rows.rolling_impulse[m, 0], rows.rolling_impulse[m, 1] = dot(rolling, t1), dot(rolling, t2)
+        xa, xb = load3(pos, a), load3(pos, b)
+        relative = sub(dx_b, dx_a)
+        rows.sweeps[m] = 1
+        for j in range(count):
+            p = load3(fresh.point[i], j)
+            manifolds.feature[m, j] = fresh.feature[i, j]
+            manifolds.separation[m, j] = fresh.separation[i, j]
+            store3(manifolds.point[m], j, p)
+            # Anchors that _arms_now carries to p - x now; the base separation that it carries to the new one.
+            ra, rb = sub(p, xa), sub(p, xb)
+            store3(rows.anchor_a[m], j, add_scaled(ra, relative, -weight_b))
+            store3(rows.anchor_b[m], j, add_scaled(rb, relative, 1.0 - weight_b))
+            rows.base_separation[m, j] = 0.0
+            _, _, moved = _arms_now(rows, m, j, n, dx_a, dq_a, dx_b, dq_b, weight_b)
+            rows.base_separation[m, j] = fresh.separation[i, j] - moved
+            rows.normal_mass[m, j] = _inverse_effective_mass(ma, ia, ra, mb, ib, rb, n)
+            rows.tangent_mass[m, j, 0] = _inverse_effective_mass(ma, ia, ra, mb, ib, rb, t1)
+            rows.tangent_mass[m, j, 1] = _inverse_effective_mass(ma, ia, ra, mb, ib, rb, t2)
+            same = -1
+            for jj in range(old_count):
+                if old_feature[jj] == fresh.feature[i, j]:
+                    same = jj
+                    break
+            if same >= 0:
+                tangent, total = load3(old_tangent, same), load3(old_total_tangent, same)
+                rows.normal_impulse[m, j] = old_normal[same]
+                rows.max_normal_impulse[m, j] = old_max[same]
+                rows.total_normal_impulse[m, j] = old_total[same]
+                rows.relative_velocity[m, j] = old_velocity[same]
+            else:
+                tangent = total = (0.0, 0.0, 0.0)
+                rows.normal_impulse[m, j] = rows.max_normal_impulse[m, j] = rows.total_normal_impulse[m, j] = 0.0
+                rows.relative_velocity[m, j] = dot(_relative_velocity(va, wa, ra, vb, wb, rb), n)
+            rows.tangent_impulse[m, j, 0], rows.tangent_impulse[m, j, 1] = dot(tangent, t1), dot(tangent, t2)
+            rows.total_tangent_impulse[m, j, 0] = dot(total, t1)
+            rows.total_tangent_impulse[m, j, 1] = dot(total, t2)
             if rows.relative_velocity[m, j] < -IMPACT_SPEED:
                 rows.sweeps[m] = IMPACT_SWEEPS
 

@@ -92,16 +92,18 @@ def integrate_positions(moving, linvel, angvel, pos, quat, h):
 @kernel
 def run_substeps(
     bodies, moving, inv_mass, gravity, force, torque, acts, rows, count, inv_inertia_world, pos, quat, pos0, quat0,
-    linvel, angvel, h, substeps, push_max, threshold, joints, joint_impulses, joint_hertz, joint_damping_ratio,
+    linvel, angvel, h, first, last, push_max, threshold, joints, joint_impulses, joint_hertz, joint_damping_ratio,
     joint_force_total, joint_moment_total,
 ):  # fmt: skip
-    """The soft step's inner loop (Catto 2024): per substep integrate velocities, bounce the ball impacts of the
-    substep, warm start (joints, then contacts), solve with a soft bias, integrate positions, relax without bias.
+    """Substeps ``first`` to ``last - 1`` of the soft step's inner loop (Catto 2024): per substep integrate
+    velocities, bounce the ball impacts of the substep, warm start (joints, then contacts), solve with a soft bias,
+    integrate positions, relax without bias. The step runs them in one call, or in several where contacts are found
+    again between them (``pipeline.contact_step``); the state between calls is all in the arrays.
     ``inv_mass`` and ``inv_inertia_world`` are zero for bodies that do not move (static or sleeping), which the
     solver then treats as fixed. ``joints`` is None in a world without joints: Numba prunes the joint solver's
     branches before typing, so such a world never compiles it."""
     inv_h = 1.0 / h
-    for k in range(substeps):
+    for k in range(first, last):
         integrate_velocities(bodies, moving, gravity, force, torque, acts, k * h, quat, linvel, angvel, h)
         resolve_impacts(rows, count, inv_mass, inv_inertia_world, pos, quat, pos0, quat0, linvel, angvel, h, threshold,
                         gravity, force, bodies.constant_force)  # fmt: skip
