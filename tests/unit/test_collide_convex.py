@@ -255,6 +255,20 @@ def test_tilted_cylinder_keeps_the_exact_lowest_rim_depth():
     np.testing.assert_allclose(m.normal, [0, 0, 1], atol=1e-12)  # measured 0
 
 
+def test_cylinder_tipped_on_its_rim_gets_the_rim_corners_within_the_margin():
+    """Tilted 30° about x, its lowest rim point 1 cm into the box: the rim's corners 45° round it are
+    0.3 sin 30° (1 - cos 45°) higher, inside a 5 cm margin, the next ones outside. One rim point (before issue 44's
+    fix) let a cylinder tipping over on a hull dig the rest of its rim in within the step."""
+    tilt = math.radians(30.0)
+    centre_z = 0.5 + 0.5 * math.cos(tilt) + 0.3 * math.sin(tilt) - 0.01
+    m = collide(Box((2, 2, 1)), (0, 0, 0), Cylinder(0.3, 1.0), (0.2, 0.1, centre_z), IDENTITY, quat((1, 0, 0), 30),
+                margin=0.05)  # fmt: skip
+    assert m.count == 3
+    np.testing.assert_allclose(m.normal, [0, 0, 1], atol=1e-12)
+    next_corner = -0.01 + 0.3 * math.sin(tilt) * (1.0 - math.cos(math.pi / 4))
+    np.testing.assert_allclose(np.sort(m.separation), [-0.01, next_corner, next_corner], atol=1e-9)
+
+
 def test_cylinder_lying_on_its_side_gets_the_two_ends_of_its_line():
     m = collide(Box((2, 2, 1)), (0, 0, 0), Cylinder(0.3, 1.0), (0.2, 0.1, 0.79), IDENTITY, quat((1, 0, 0), 90))
     assert m.count == 2
