@@ -194,6 +194,22 @@ def _relative_velocity(v_a, w_a, r_a, v_b, w_b, r_b):
     return sub(add(v_b, cross(w_b, r_b)), add(v_a, cross(w_a, r_a)))
 
 
+@inline
+def _write_point_masses(rows, m, j, ma, ia, ra, mb, ib, rb, n, t1, t2):
+    """Point ``j`` of row ``m``: the inverse effective masses along the normal and the two tangents."""
+    rows.normal_mass[m, j] = _inverse_effective_mass(ma, ia, ra, mb, ib, rb, n)
+    rows.tangent_mass[m, j, 0] = _inverse_effective_mass(ma, ia, ra, mb, ib, rb, t1)
+    rows.tangent_mass[m, j, 1] = _inverse_effective_mass(ma, ia, ra, mb, ib, rb, t2)
+
+
+@inline
+def _write_rolling_masses(rows, m, ia, ib, t1, t2):
+    """Row ``m``'s rolling-resistance masses about the two tangents (only where it rolls with resistance)."""
+    if rows.rolling[m] > 0.0:
+        rows.rolling_mass[m, 0] = _inverse_angular_mass(ia, ib, t1)
+        rows.rolling_mass[m, 1] = _inverse_angular_mass(ia, ib, t2)
+
+
 @kernel
 def prepare_contacts(
     manifolds, count, shape_body, shape_friction, shape_restitution, shape_rolling, shape_core_radius, inv_mass,
@@ -231,18 +247,14 @@ def prepare_contacts(
         xa, xb = load3(pos, a), load3(pos, b)
         rows.point_count[m] = manifolds.point_count[m]
         rows.rolling_impulse[m, 0] = rows.rolling_impulse[m, 1] = 0.0
-        if rows.rolling[m] > 0.0:
-            rows.rolling_mass[m, 0] = _inverse_angular_mass(ia, ib, t1)
-            rows.rolling_mass[m, 1] = _inverse_angular_mass(ia, ib, t2)
+        _write_rolling_masses(rows, m, ia, ib, t1, t2)
         for j in range(manifolds.point_count[m]):
             p = load3(manifolds.point[m], j)
             ra, rb = sub(p, xa), sub(p, xb)
             store3(rows.anchor_a[m], j, ra)
             store3(rows.anchor_b[m], j, rb)
             rows.base_separation[m, j] = manifolds.separation[m, j]
-            rows.normal_mass[m, j] = _inverse_effective_mass(ma, ia, ra, mb, ib, rb, n)
-            rows.tangent_mass[m, j, 0] = _inverse_effective_mass(ma, ia, ra, mb, ib, rb, t1)
-            rows.tangent_mass[m, j, 1] = _inverse_effective_mass(ma, ia, ra, mb, ib, rb, t2)
+            _write_point_masses(rows, m, j, ma, ia, ra, mb, ib, rb, n, t1, t2)
             rows.normal_impulse[m, j] = warm_normal[m, j]
             warm_t = load3(warm_tangent[m], j)
             rows.tangent_impulse[m, j, 0] = dot(warm_t, t1)
@@ -307,9 +319,7 @@ def rebase_contacts(listed, fresh, manifolds, rows, inv_mass, inv_inertia_world,
             manifolds.normal[m, c] = rows.normal[m, c] = n[c]
             rows.tangent1[m, c], rows.tangent2[m, c] = t1[c], t2[c]
         manifolds.point_count[m] = rows.point_count[m] = count
-        if rows.rolling[m] > 0.0:
-            rows.rolling_mass[m, 0] = _inverse_angular_mass(ia, ib, t1)
-            rows.rolling_mass[m, 1] = _inverse_angular_mass(ia, ib, t2)
+        _write_rolling_masses(rows, m, ia, ib, t1, t2)
         rows.rolling_impulse[m, 0], rows.rolling_impulse[m, 1] = dot(rolling, t1), dot(rolling, t2)
         xa, xb = load3(pos, a), load3(pos, b)
         relative = sub(dx_b, dx_a)
@@ -326,9 +336,7 @@ def rebase_contacts(listed, fresh, manifolds, rows, inv_mass, inv_inertia_world,
             rows.base_separation[m, j] = 0.0
             _, _, moved = _arms_now(rows, m, j, n, dx_a, dq_a, dx_b, dq_b, weight_b)
             rows.base_separation[m, j] = fresh.separation[i, j] - moved
-            rows.normal_mass[m, j] = _inverse_effective_mass(ma, ia, ra, mb, ib, rb, n)
-            rows.tangent_mass[m, j, 0] = _inverse_effective_mass(ma, ia, ra, mb, ib, rb, t1)
-            rows.tangent_mass[m, j, 1] = _inverse_effective_mass(ma, ia, ra, mb, ib, rb, t2)
+            _write_point_masses(rows, m, j, ma, ia, ra, mb, ib, rb, n, t1, t2)
             same = -1
             for jj in range(old_count):
                 if old_feature[jj] == fresh.feature[i, j]:
