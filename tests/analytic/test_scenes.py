@@ -104,6 +104,38 @@ def test_mixed_piles_of_40_to_60_bodies_stay_in_the_mesh_bowl_at_60_and_240_hz(s
     assert kept > 0.9
 
 
+@functools.cache
+def poured_pile_depths(seed: int, rate: float) -> tuple[float, float, float]:
+    """``scenes.mixed_pile(50, seed)`` stepped at ``rate`` Hz for 4 s, as ``mixed_drop_depths``."""
+    return overlap_depths(scenes.mixed_pile(50, seed), rate, 4.0)
+
+
+# 50 shapes poured into the bowl: no contact goes deeper than issue 44's targets, 5 cm at 60 Hz and 2.5 cm at
+# 240 Hz, into the bowl or between bodies. Measured over seeds 1-20: 1.3-4.0 cm into the bowl and 2.2-4.7 cm between
+# bodies at 60 Hz, 0.4-2.1 and 0.9-2.4 cm at 240 Hz; but for two seeds held as strict xfails, where a box and a
+# cylinder go in deeper. (The overlaps mixed_pile builds with are left out: overlap_depths.)
+POUR_BOUNDS = {60.0: 0.05, 240.0: 0.025}
+POUR_MISSES = {(13, 60.0): "6.0 cm between a box and a cylinder", (18, 60.0): "5.2 cm between a box and a cylinder"}
+
+
+def _pile_case(seed, rate, misses):
+    """A seed and rate of a pile test: seeds 1-3 at 60 Hz in ``make test``, the rest slow; a measured miss of issue
+    44's target a strict xfail, so that a fix shows."""
+    marks = [] if rate == 60.0 and seed <= 3 else [pytest.mark.slow]
+    if (seed, rate) in misses:
+        marks.append(pytest.mark.xfail(strict=True, reason=f"issue 44, part 3: {misses[seed, rate]} (docs/contact.md)"))
+    return pytest.param(seed, rate, marks=marks)
+
+
+@pytest.mark.parametrize(
+    ("seed", "rate"), [_pile_case(seed, rate, POUR_MISSES) for rate in (60.0, 240.0) for seed in range(1, 21)]
+)
+def test_shapes_poured_into_the_bowl_overlap_at_most_5_cm_at_60_hz_and_2_5_cm_at_240_hz(seed, rate):
+    into_bowl, between_bodies, _ = poured_pile_depths(seed, rate)
+    assert into_bowl < POUR_BOUNDS[rate]
+    assert between_bodies < POUR_BOUNDS[rate]
+
+
 def test_a_row_of_dominoes_topples_to_the_last():
     world = scenes.dominoes(20)
     world.simulate(3.0, DT)
@@ -150,20 +182,16 @@ def mixed_drop_depths(seed: int, rate: float) -> tuple[float, float, float]:
 
 
 # 60 shapes dropped from 5-6.2 m onto the ground, landing on each other at 10-11 m/s: none passes through the ground
-# or sinks its centre into it, and no contact goes deeper than issue 44's target at 60 Hz, 5 cm. Measured over seeds
-# 1-13 at 60 Hz: into the ground 2.1-4.4 cm, between bodies 2.2-4.4 cm (contacts found once a step: 4.2-8.4 and
-# 5.9-10.8 cm). At 240 Hz the bounds are what was measured over seeds 1-20: 0.3-3.5 cm and 1.1-3.0 cm (seeds 1-10,
-# run here: 0.3-2.3 and 1.1-1.8 cm).
-DROP_BOUNDS = {60.0: (0.05, 0.05), 240.0: (0.04, 0.04)}  # (into the ground, between bodies) [m]
+# or sinks its centre into it, and no contact goes deeper than issue 44's targets, 5 cm at 60 Hz and 2.5 cm at
+# 240 Hz. Measured over seeds 1-20: into the ground 1.1-3.7 cm and between bodies 2.3-5.0 cm at 60 Hz (contacts found
+# once a step: 4.2-8.4 and 5.9-10.8 cm), 0.3-1.9 and 1.1-2.1 cm at 240 Hz; but for two seeds held as strict xfails
+# below, where two bodies go in deeper.
+DROP_BOUNDS = {60.0: (0.05, 0.05), 240.0: (0.025, 0.025)}  # (into the ground, between bodies) [m]
+DROP_MISSES = {(15, 60.0): "6.2 cm between bodies", (17, 240.0): "3.0 cm between a capsule and a cylinder"}
 
 
 @pytest.mark.parametrize(
-    ("seed", "rate"),
-    [
-        *((seed, 60.0) for seed in range(1, 4)),
-        *(pytest.param(seed, 60.0, marks=pytest.mark.slow) for seed in range(4, 14)),
-        *(pytest.param(seed, 240.0, marks=pytest.mark.slow) for seed in range(1, 11)),
-    ],
+    ("seed", "rate"), [_pile_case(seed, rate, DROP_MISSES) for rate in (60.0, 240.0) for seed in range(1, 21)]
 )
 def test_shapes_dropped_on_the_ground_at_10_m_per_s_stay_out_of_it(seed, rate):
     into_ground, between_bodies, lowest = mixed_drop_depths(seed, rate)
@@ -196,14 +224,6 @@ def test_a_body_landing_at_11_m_per_s_goes_at_most_2_cm_into_the_ground(make):
             world.step(DT)
             deepest = max(deepest, -world.contacts().separation.min(initial=0.0))
     assert deepest < 0.02
-
-
-# Issue 44's target at 240 Hz, 2.5 cm, holds over seeds 1-13 and 15-16, 18-19 but not 14 (3.5 cm into the ground), 17
-# (3.0 cm between bodies) or 20 (3.3 cm into the ground): docs/contact.md, "Deep overlaps in piles".
-@pytest.mark.slow
-@pytest.mark.xfail(strict=True, reason="issue 44, part 3: transient overlaps over 2.5 cm at 240 Hz (docs/contact.md)")
-def test_the_deepest_overlap_of_shapes_dropped_at_10_m_per_s_is_at_most_2_5_cm_at_240_hz():
-    assert max(mixed_drop_depths(14, 240.0)[:2]) <= 0.025
 
 
 def slide_over_the_rim(shape, azimuth: float, speed: float, rate: float) -> tuple[float, int, int, float]:

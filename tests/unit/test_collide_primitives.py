@@ -549,6 +549,22 @@ def test_reduce_manifold_keeps_the_deepest_then_the_widest_spread():
     assert area_2d(points[chosen]) == pytest.approx(2.0, abs=1e-12)
 
 
+def test_reduce_manifold_keeps_the_corner_that_comes_down_next_over_wider_ones_higher_up():
+    # A hull tipped onto one corner (index 0): a corner 1.4 cm up and 34 cm away (index 1) is the next to come down
+    # as it tips on, and must not lose its place to three wider ones 8.3-8.5 cm up (issue 44: it went 3.5 cm into
+    # the ground within a 240 Hz step). Chosen by spread alone, it was the one left out.
+    points = np.array([
+        (0.0, 0.0, 0.0), (0.34, 0.0, 0.014), (0.45, 0.1, 0.083), (0.2, 0.45, 0.084), (0.2, -0.45, 0.085),
+    ])  # fmt: skip
+    count, *chosen = cp.reduce_manifold(points, (0.0, 0.0, 1.0), 0.0, 0.1)
+    assert count == 4 and chosen[:2] == [0, 1]
+    # Tilted less than the slope preference (tan 2.9°), a face keeps its widest spread: the far corner second.
+    flat = points.copy()
+    flat[:, 2] = 0.01 * np.hypot(flat[:, 0], flat[:, 1]) * np.array([0.0, 1.0, 4.0, 4.0, 4.0])
+    count, *chosen = cp.reduce_manifold(flat, (0.0, 0.0, 1.0), 0.0, 0.1)
+    assert count == 4 and chosen[:2] == [0, 3]
+
+
 def test_reduce_manifold_drops_duplicates_and_points_beyond_the_margin():
     # Three equally deep points: the anchor is the one farthest from their centroid (index 2), then the first of
     # the two duplicates; the fourth is beyond the margin.

@@ -112,6 +112,9 @@ _TIE_DISTANCE = 1e-9
 # of the solver's 5 mm slop), and incident corners that far past the reference face's rim count as on it: solver
 # noise (a stack twisting by 1e-4 rad) then changes neither the chosen points nor their feature ids.
 _PREFERENCE = 1e-4
+# A manifold's second point is the farthest of those whose rise per distance from the first is within this of the
+# least (tan 2.9°): a face tilted less than that still keeps its widest spread.
+_SLOPE_PREFERENCE = 0.05
 # Separating-axis bias (after Gregorius 2013 and Box2D's 0.98 × + ½ slop): another axis replaces the preferred
 # one (faces of a, then faces of b, then edges) only when its separation is larger by 5 % of the preferred one's
 # size plus 1 mm. Round-off and small rotations then never flip the reference face between steps.
@@ -241,9 +244,10 @@ def reduce_manifold(points, normal, offset, margin):
     """Choose up to four of the candidate ``points`` that lie below ``margin`` from the plane ``normal · x = offset``.
 
     A deepest point comes first (it carries the penetration): of those within ``_PREFERENCE`` of the deepest, the
-    one farthest from their centroid, a corner of the contact polygon. Then the one farthest from it in the plane,
-    the one making the largest triangle with those two, and the one adding the most area outside that triangle
-    (Gregorius, GDC 2015). Points within ``_MERGE_DISTANCE`` of the chosen ones add nothing and are skipped. A
+    one farthest from their centroid, a corner of the contact polygon. Then the one that comes down next as the
+    shape tips about it (the least rise per distance; of those within ``_SLOPE_PREFERENCE`` of it, the farthest in
+    the plane), the one making the largest triangle with those two, and the one adding the most area outside that
+    triangle (Gregorius, GDC 2015). Points within ``_MERGE_DISTANCE`` of the chosen ones add nothing and are skipped. A
     candidate must beat the best so far by ``_PREFERENCE`` to replace it, so nearly equal candidates (a face lying
     flat) resolve to the lowest index whatever the round-off or solver noise, and the chosen ids stay the same
     from step to step; the deepest point kept can be up to 0.1 mm shallower than the deepest candidate.
@@ -281,12 +285,22 @@ def reduce_manifold(points, normal, offset, margin):
     if i0 < 0:
         return 0, -1, -1, -1, -1
     p0 = points[i0]
-    # Farthest from it within the contact plane.
+    s0 = dot(p0, normal) - offset
+    # The first to come down as the shape tips about it: the least rise per distance in the plane. Of those within
+    # _SLOPE_PREFERENCE of that, the farthest, so that a face lying flat keeps its widest spread. A corner 1.4 cm up
+    # and 34 cm away must not lose its place to wider ones 8 cm up: it is the one that goes in next.
+    least = math.inf
+    for k in range(count):
+        if dot(points[k], normal) - offset < margin:
+            distance = _planar_distance(points[k], p0, normal)
+            if distance > _MERGE_DISTANCE:
+                least = min(least, (dot(points[k], normal) - offset - s0) / distance)
     i1, best = -1, _MERGE_DISTANCE
     for k in range(count):
         if dot(points[k], normal) - offset < margin:
             distance = _planar_distance(points[k], p0, normal)
-            if distance > best + _PREFERENCE:
+            slope = (dot(points[k], normal) - offset - s0) / max(distance, _MERGE_DISTANCE)
+            if slope <= least + _SLOPE_PREFERENCE and distance > best + _PREFERENCE:
                 best, i1 = distance, k
     if i1 < 0:
         return 1, i0, -1, -1, -1
