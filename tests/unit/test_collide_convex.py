@@ -269,6 +269,30 @@ def test_cylinder_tipped_on_its_rim_gets_the_rim_corners_within_the_margin():
     np.testing.assert_allclose(np.sort(m.separation), [-0.01, next_corner, next_corner], atol=1e-9)
 
 
+def test_cylinder_rim_over_a_box_edge_gets_the_rim_corners_over_the_face_beside_the_deepest_point():
+    """Tipped 10° about x and hanging 10 cm over the box's edge, the rim digs in by the edge: GJK's normal faces
+    neither the box's face nor the disc to REF_COS, and the pair kept that one point, about which a cylinder tipped
+    on a box rocked from one side of its rim to the other and dug each in (issue 44: 6.0 cm in the bowl). Within
+    NEAR_FACE_COS of the face, the rim corners over it join the deepest point, each measured along the normal from
+    the plane the box lies under: never farther apart than the rim corner really is from the box."""
+    box, cylinder = Box((2, 2, 1)), Cylinder(0.3, 1.0)
+    pos_b, quat_b = (1.1, 0.0, 1.0), quat((1, 0, 0), 10)
+    m = collide(box, (0, 0, 0), cylinder, pos_b, IDENTITY, quat_b, margin=0.05)
+    geom = pack_geometry([box, cylinder], [0, 1], np.zeros((2, 3)), np.tile([1.0, 0.0, 0.0, 0.0], (2, 1)))
+    box_core, cylinder_core = gjk.core_proxy(geom, 0, -1), gjk.core_proxy(geom, 1, -1)
+    found, depth, normal, _, _ = gjk.proxy_contact(box_core, (0.0, 0.0, 0.0), IDENTITY, cylinder_core, pos_b, quat_b,
+                                                   geom.vertex_local, 0.05)  # fmt: skip
+    assert found and depth == pytest.approx(-0.0414, abs=1e-4)
+    assert m.count == 4
+    np.testing.assert_allclose(m.normal, normal, atol=1e-15)
+    assert m.separation.min() == depth
+    for point, separation in zip(m.point, m.separation, strict=True):
+        rim_corner = point + 0.5 * separation * np.asarray(normal)
+        assert rim_corner[0] <= 1.0 + 1e-9  # over the box's top face
+        outside = np.maximum(np.abs(rim_corner) - (1.0, 1.0, 0.5), 0.0)
+        assert separation <= np.linalg.norm(outside) + 1e-12
+
+
 def test_cylinder_lying_on_its_side_gets_the_two_ends_of_its_line():
     m = collide(Box((2, 2, 1)), (0, 0, 0), Cylinder(0.3, 1.0), (0.2, 0.1, 0.79), IDENTITY, quat((1, 0, 0), 90))
     assert m.count == 2
@@ -362,6 +386,22 @@ def test_round_shapes_on_the_ground():
     np.testing.assert_allclose(cylinder.separation, -0.01, atol=1e-9)  # measured 1e-17
     hull = collide(CUBE, (0.3, -0.2, 0.49), GROUND, (0, 0, 0))
     assert hull.count == 4
+
+
+def test_a_tipped_capsule_on_a_mesh_triangle_gets_both_ends_within_the_margin():
+    """Tipped 8° off lying flat (past FLAT_SIN), its lower end 1 cm into a triangle and its upper end 0.6 sin 8° higher:
+    both ends within the margin. By its lower end only, a capsule hit from above turned about it and drove the other
+    6-8 cm into the bowl within the step (issue 44)."""
+    tilt = math.radians(8.0)
+    centre_z = 0.2 + 0.3 * math.sin(tilt) - 0.01
+    m = collide(Capsule(0.2, 0.6), (2.0, -1.0, centre_z), GROUND, (0, 0, 0), quat((0, 1, 0), 90 - 8), margin=0.1)
+    assert m.count == 2
+    np.testing.assert_allclose(m.normal, [0, 0, -1], atol=1e-12)
+    np.testing.assert_allclose(np.sort(m.separation), [-0.01, -0.01 + 0.6 * math.sin(tilt)], atol=1e-12)
+    ends = [
+        (2.0 + s * 0.3 * math.cos(tilt), -1.0, 0.5 * h) for s, h in ((-1, -0.01), (1, -0.01 + 0.6 * math.sin(tilt)))
+    ]
+    same_points(m.point, ends, 1e-12)
 
 
 def test_nothing_far_from_the_mesh():

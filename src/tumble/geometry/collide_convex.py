@@ -57,6 +57,7 @@ __all__ = [
     "CAP_POINTS",
     "FLAT_SIN",
     "REF_COS",
+    "NEAR_FACE_COS",
     "FACE_BIAS_RELATIVE",
     "FACE_BIAS",
     "TRIANGLE_FACE_BIAS",
@@ -86,6 +87,9 @@ FLAT_SIN = 0.1
 # normal of a true face contact comes out of GJK/EPA exact to round-off (a curved rim's to ~1e-5 rad), while near an
 # edge or a corner it leans over, and measuring along the face's normal there overstates the depth.
 REF_COS = 1.0 - 1e-9
+# Neither feature faces the normal to REF_COS, but a face within 30° of it (a box's face under a tipped cylinder's rim)
+# is clipped against as a near face (_collide_smooth).
+NEAR_FACE_COS = 0.8660254037844387
 # Preference for face axes over edge axes, and for A's faces over B's (Gregorius 2013; Box2D's 0.98 x + slop): another
 # axis wins only if it separates better by 5 % of the preferred axis's separation plus 1e-3 of the pair's size, so
 # round-off and small rotations never flip the reference face between steps. collide_box_box uses the same 5 %.
@@ -101,6 +105,7 @@ MESH_MAX_CANDIDATES = 64
 # Feature ids: bits 0-15 the clipped point (an incident vertex, or a side plane and the edge it cut), 16-27 the
 # incident feature, 28-39 the reference feature, bit 40 set when the reference is B's, bits 41-62 the mesh triangle.
 _EDGE_POINT = 0xFFFF
+_DEEPEST_POINT = 0xFFFE
 _TRIANGLE_SHIFT = 41
 
 
@@ -460,13 +465,15 @@ def _write_four(points, seps, ids, m, n, point, separation, feature):
 
 
 @inline
-def _clip_points(ref, ref_count, ref_n, inc, inc_count, inc_radius, margin, base_id, out_point, out_sep, out_id):
+def _clip_points(ref, ref_count, ref_n, inc, inc_count, inc_radius, plane_n, plane_offset, margin, base_id, out_point,
+                 out_sep, out_id):  # fmt: skip
     """Contact points of an incident feature (polygon, segment or point core: rows ``[:inc_count]`` of ``inc``) over a
     reference face (convex polygon ``ref[:ref_count]``, either winding, outward unit normal ``ref_n``).
 
     Clips the incident feature against the side planes of the reference face, measures each point's height above the
-    face's plane less ``inc_radius``, and writes those within ``margin``, midway between the two surfaces, into
-    ``out_*`` (room for ``inc_count + ref_count`` rows). Returns how many.
+    plane ``plane_n · x = plane_offset`` (the face's own, or one the reference shape lies under) less
+    ``inc_radius``, and writes those within ``margin``, midway between the two surfaces, into ``out_*`` (room for
+    ``inc_count + ref_count`` rows). Returns how many.
     """
     # A convex incident feature gains at most one vertex per side plane. Rows are written before they are read.
     cap = inc_count + ref_count
@@ -529,14 +536,13 @@ def _clip_points(ref, ref_count, ref_n, inc, inc_count, inc_radius, margin, base
         m = out
         if m == 0:
             return 0
-    # Heights above the reference plane; each point goes midway between the two surfaces.
-    ref_offset = dot(ref_n, _row(ref, 0))
+    # Heights above the plane; each point goes midway between the two surfaces.
     kept = 0
     for k in range(m):
         p = _row(buf, k)
-        height = dot(ref_n, p) - ref_offset
+        height = dot(plane_n, p) - plane_offset
         if height - inc_radius <= margin:
-            _set_row(out_point, kept, add_scaled(p, ref_n, -0.5 * (height + inc_radius)))
+            _set_row(out_point, kept, add_scaled(p, plane_n, -0.5 * (height + inc_radius)))
             out_sep[kept] = height - inc_radius
             out_id[kept] = base_id | (buf_ids[k] & 0xFFFF)
             kept += 1
@@ -653,7 +659,8 @@ def _face_contact(poly_ref, face_ref, poly_inc, margin, flip, out_point, out_sep
     for k in range(fcount_i[face_inc]):
         _set_row(inc, k, _row(vertex_i, floop_i[fstart_i[face_inc] + k]))
     base_id = ((1 << 40) if flip else 0) | ((face_ref & 0xFFF) << 28) | ((face_inc & 0xFFF) << 16)
-    count = _clip_points(ref, ref.shape[0], n, inc, inc.shape[0], 0.0, margin, base_id, out_point, out_sep, out_id)
+    count = _clip_points(ref, ref.shape[0], n, inc, inc.shape[0], 0.0, n, dot(n, _row(ref, 0)), margin, base_id,
+                         out_point, out_sep, out_id)  # fmt: skip
     return count, (_neg(n) if flip else n)
 
 
@@ -810,16 +817,51 @@ def _collide_smooth(geom, sa, fa, pa, qa, sb, fb, pb, qb, margin, out_point, out
         else:
             ref_a = align_a >= align_b
         ref_b = not ref_a
+    # A capsule on a mesh's triangle (always B) is held by its whole segment: by its nearer end only, a capsule hit
+    # from above turned about that end and drove the other 6-8 cm into the bowl within the step (issue 44).
+    if ref_b and fb >= 0 and ka == 1 and geom.shape_type[sa] == CAPSULE:
+        half = geom.shape_params[sa, 1]
+        _set_row(feat_a, 0, add(pa, quat_rotate(qa, (0.0, 0.0, -half))))
+        _set_row(feat_a, 1, add(pa, quat_rotate(qa, (0.0, 0.0, half))))
+        ka = 2
+    # Neither faces the normal, but one is a face within NEAR_FACE_COS of it: the other's feature clipped to it, each
+    # point's separation measured along the normal from the plane the face's shape lies under (a lower bound on its
+    # distance), and the deepest point besides. One point let a cylinder tipped on a box's edge rock from one side of
+    # its rim to the other and dig each in (issue 44: 6 cm).
+    near = not (ref_a or ref_b) and fa < 0 and fb < 0
+    near_a = near and ka >= 3 and kb >= 2 and align_a >= NEAR_FACE_COS
+    near_b = near and kb >= 3 and ka >= 2 and align_b >= NEAR_FACE_COS
+    if near_a and near_b:
+        near_a = align_a >= align_b
+        near_b = not near_a
     count = 0
     normal = n
+    id_a_ref = ((id_a & 0xFFF) << 28) | ((id_b & 0xFFF) << 16)
+    id_b_ref = (1 << 40) | ((id_b & 0xFFF) << 28) | ((id_a & 0xFFF) << 16)
     if ref_a and kb >= 2:
-        base_id = ((id_a & 0xFFF) << 28) | ((id_b & 0xFFF) << 16)
-        count = _clip_points(feat_a, ka, na, feat_b, kb, rb, margin, base_id, out_point, out_sep, out_id)
+        base_id = id_a_ref
+        count = _clip_points(feat_a, ka, na, feat_b, kb, rb, na, dot(na, _row(feat_a, 0)), margin, base_id, out_point,
+                             out_sep, out_id)  # fmt: skip
         normal = na
     elif ref_b and ka >= 2:
-        base_id = (1 << 40) | ((id_b & 0xFFF) << 28) | ((id_a & 0xFFF) << 16)
-        count = _clip_points(feat_b, kb, nb, feat_a, ka, ra, margin, base_id, out_point, out_sep, out_id)
+        base_id = id_b_ref
+        count = _clip_points(feat_b, kb, nb, feat_a, ka, ra, nb, dot(nb, _row(feat_b, 0)), margin, base_id, out_point,
+                             out_sep, out_id)  # fmt: skip
         normal = _neg(nb)
+    elif near_a or near_b:
+        if near_a:
+            base_id = id_a_ref
+            count = _clip_points(feat_a, ka, na, feat_b, kb, rb, n, dot(n, wa), margin, base_id, out_point, out_sep,
+                                 out_id)  # fmt: skip
+        else:
+            base_id = id_b_ref
+            count = _clip_points(feat_b, kb, nb, feat_a, ka, ra, _neg(n), -dot(n, wb), margin, base_id, out_point,
+                                 out_sep, out_id)  # fmt: skip
+        # The deepest point: clipping may have cut it off (it lies past the face's outline, on a rim or an edge).
+        _set_row(out_point, count, scale(add(wa, wb), 0.5))
+        out_sep[count] = sep
+        out_id[count] = base_id | _DEEPEST_POINT
+        count += 1
     elif ka == 2 and kb == 2:
         count = _segment_pair(_row(feat_a, 0), _row(feat_a, 1), ra, _row(feat_b, 0), _row(feat_b, 1), rb, n, margin,
                               out_point, out_sep, out_id)  # fmt: skip
