@@ -23,7 +23,11 @@ phase sends it the pairs that have no closed form (anything with a cylinder or a
   segment, when the axis is within ``asin(FLAT_SIN)`` of lying flat. When one feature is a face facing the normal
   (to ``REF_COS``) it is the reference, and the other feature, clipped against it as above, gives up to four points
   (a standing cylinder gets four of its rim corners, a tipped one those within the margin, a lying one or a capsule
-  two). Two parallel segments give two points. Everything else is one point.
+  two; a tipped capsule against a mesh triangle gives its whole segment too). When neither faces the normal but
+  one is a face within ``acos(NEAR_FACE_COS)`` (30°) of it, as under a cylinder's rim tipped over a box's edge, the
+  other feature is clipped against that face and each point measured along GJK's normal from the plane the face's
+  shape lies under, a lower bound on its distance; GJK's deepest point joins them. Two parallel segments give two
+  points. Everything else is one point.
 
 :func:`collide_convex_trimesh` collides a convex shape with each triangle of a static mesh whose bounds (in the
 mesh frame) overlap the shape's, by the same two roads with the triangle as shape B (two-sided), and merges the
@@ -690,6 +694,13 @@ def _candidate_capacity(geom, sa, fa, sb, fb):
 
 
 @inline
+def _write_axis_line(out, pos, quat, x, y, half):
+    """Rows 0 and 1 of ``out``: the world ends of the line ``(x, y, ±half)`` of a capsule's or cylinder's frame."""
+    _set_row(out, 0, add(pos, quat_rotate(quat, (x, y, -half))))
+    _set_row(out, 1, add(pos, quat_rotate(quat, (x, y, half))))
+
+
+@inline
 def _support_feature(geom, shape, face, pos, quat, d, out):
     """The feature of a shape's core farthest along the unit world direction ``d``, as world points in ``out``.
 
@@ -743,8 +754,7 @@ def _support_feature(geom, shape, face, pos, quat, d, out):
     rx, ry = (dl[0] / rho, dl[1] / rho) if rho > 1e-12 else (1.0, 0.0)
     if abs(axial) <= FLAT_SIN:
         r = geom.shape_params[shape, 0] if t == CYLINDER else 0.0
-        _set_row(out, 0, add(pos, quat_rotate(quat, (r * rx, r * ry, -half))))
-        _set_row(out, 1, add(pos, quat_rotate(quat, (r * rx, r * ry, half))))
+        _write_axis_line(out, pos, quat, r * rx, r * ry, half)
         return 2, zero, 0.0, 0, False
     if t == CAPSULE:
         _set_row(out, 0, add(pos, quat_rotate(quat, (0.0, 0.0, half if axial >= 0.0 else -half))))
@@ -820,9 +830,7 @@ def _collide_smooth(geom, sa, fa, pa, qa, sb, fb, pb, qb, margin, out_point, out
     # A capsule on a mesh's triangle (always B) is held by its whole segment: by its nearer end only, a capsule hit
     # from above turned about that end and drove the other 6-8 cm into the bowl within the step (issue 44).
     if ref_b and fb >= 0 and ka == 1 and geom.shape_type[sa] == CAPSULE:
-        half = geom.shape_params[sa, 1]
-        _set_row(feat_a, 0, add(pa, quat_rotate(qa, (0.0, 0.0, -half))))
-        _set_row(feat_a, 1, add(pa, quat_rotate(qa, (0.0, 0.0, half))))
+        _write_axis_line(feat_a, pa, qa, 0.0, 0.0, geom.shape_params[sa, 1])
         ka = 2
     # Neither faces the normal, but one is a face within NEAR_FACE_COS of it: the other's feature clipped to it, each
     # point's separation measured along the normal from the plane the face's shape lies under (a lower bound on its
