@@ -294,8 +294,8 @@ def contact_step(
             scratch.joint_moment_total,
         )
 
-    # Fast pairs find their contacts again within the step (contact_passes); each pair by its own motion only, so a
-    # batch's copies step as separate worlds would.
+    # Fast pairs, and the other pairs of their moving bodies, find their contacts again within the step
+    # (contact_passes); by the motion of their own bodies only, so a batch's copies step as separate worlds would.
     passes = np.empty(count, dtype=np.int64)
     if substeps > 1 and contact_passes(geom.shape_body, geom.shape_aabb_center_local, geom.shape_aabb_half_local,
                                        moving, manifolds.shape_a, manifolds.shape_b, count, state.body_linvel, angvel,
