@@ -24,9 +24,12 @@ def _passes(linvel, pairs, moving=(False, True, True, True)):
 def test_slow_pairs_find_their_contacts_once_and_fast_ones_up_to_the_cap():
     still = np.zeros((4, 3))
     assert _passes(still, [(0, 1), (0, 2)]) == (1, [1, 1])
-    # 3 m/s closes 5 cm in the step, 0.58 of a 10 cm box's bounding radius (8.7 cm) and more than PASS_TRAVEL of it.
+    # A 10 cm box's bounding radius is 8.7 cm: at 1 m/s it closes 1.7 cm in the step, 0.19 of it and less than
+    # PASS_TRAVEL (a quarter); at 2 m/s 3.3 cm, 0.38 of it, so twice.
     fast = still.copy()
-    fast[3] = (0.0, 0.0, -3.0)
+    fast[3] = (0.0, 0.0, -1.0)
+    assert _passes(fast, [(0, 3)]) == (1, [1])
+    fast[3] = (0.0, 0.0, -2.0)
     assert _passes(fast, [(0, 3)]) == (2, [2])
     fast[3] = (0.0, 0.0, -100.0)
     assert _passes(fast, [(0, 3)]) == (MAX_CONTACT_PASSES, [MAX_CONTACT_PASSES])
