@@ -38,7 +38,7 @@ def test_slow_pairs_find_their_contacts_once_and_fast_ones_up_to_the_cap():
 def test_a_body_in_a_fast_pair_finds_all_its_contacts_as_often():
     # Box 1 rests on the ground, box 3 falls onto it at 10 m/s, box 2 rests on the ground beside them. Struck at the
     # start of the step, box 1 turns within it: its ground contacts are found as often as the pair that strikes it
-    # (a hull struck so put a corner its manifold had left out 9 cm into the ground). Box 2 is not in a fast pair.
+    # (a hull struck so put a corner its manifold had left out 2.7 cm into the ground). Box 2 is not in a fast pair.
     linvel = np.zeros((4, 3))
     linvel[3] = (0.0, 0.0, -10.0)
     most, passes = _passes(linvel, [(0, 1), (0, 2), (1, 3)])

@@ -218,8 +218,11 @@ def contact_passes(shape_body, aabb_center_local, aabb_half_local, moving, shape
         if travel > PASS_TRAVEL * radius:
             passes[m] = min(MAX_CONTACT_PASSES, math.ceil(travel / (PASS_TRAVEL * radius)))
         most = max(most, passes[m])
-    # A body in a fast pair finds all its contacts as often: struck at the start of the step, a slow hull resting on
-    # the ground turned at 50 rad/s and put a corner its manifold had left out 9 cm into the ground within the step.
+    if most == 1:
+        return most  # no fast pair: nothing to pass on (and no per-body array to fill in a large world)
+    # A body in a fast pair finds all its contacts as often: struck at the start of the step, a slow hull on the
+    # ground turned at up to 50 rad/s and put a corner its manifold had left out 2.7 cm into the ground within a 240 Hz
+    # step (mixed_drop seed 11).
     body_passes = np.ones(moving.shape[0], dtype=np.int64)
     for m in range(count):
         for s in (shape_a[m], shape_b[m]):
