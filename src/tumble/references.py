@@ -15,6 +15,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from . import portable
 from ._validate import as_array, as_float, as_vector3
 from .flight.kernels import CIRCLE, HOVER, LISSAJOUS, MINIMUM_SNAP, reference_derivatives
 
@@ -219,13 +220,15 @@ class MinimumSnap(_Reference):
         with warnings.catch_warnings():
             warnings.simplefilter("error", LinAlgWarning)
             try:
-                return solve(matrix, rhs).reshape(segments, _COEFFICIENTS, 3)
+                solve(matrix, rhs)  # only for LAPACK's condition check: its values depend on the BLAS kernel
             except (LinAlgWarning, LinAlgError) as error:
                 raise ValueError(
                     f"times give segments of {durations.min():.3g} to {durations.max():.3g} s, too unequal to solve "
                     "for (the continuity of the 6th derivative scales with the duration to the 6th power): space "
                     "the times more evenly"
                 ) from error
+        # The coefficients feed the flight: the same bits on every machine (portable.solve's fixed order).
+        return portable.solve(matrix, rhs).reshape(segments, _COEFFICIENTS, 3)
 
     @property
     def duration(self) -> float:
