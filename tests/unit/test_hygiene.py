@@ -98,6 +98,72 @@ def test_validation_helpers_import_nothing_of_tumble():
     assert _import_graph()["tumble._validate"] == set()
 
 
+# --- the engine's layers (issue 45) ---------------------------------------------------------------------------
+
+# The engine, and what sits on top of it that the engine must not import.
+ENGINE = ("tumble.world", "tumble.pipeline", "tumble.dynamics", "tumble.geometry")
+ABOVE_ENGINE = ("tumble.control", "tumble.vehicles", "tumble.flight", "tumble.envs", "tumble.models",
+                "tumble.scene_file", "tumble.cli")  # fmt: skip
+# Imports that break those rules today, each to go with a part of issue 45; the test fails when one goes (take it off
+# this list) or another comes.
+KNOWN_CIRCLES = [
+    ["tumble.articulation", "tumble.models.build", "tumble.models.mjcf", "tumble.models.mjcf.springs",
+     "tumble.models.urdf", "tumble.models.urdf.reader"],
+    ["tumble.flight", "tumble.vehicles"],
+    ["tumble", "tumble.batch", "tumble.checkpoint", "tumble.models.build_world", "tumble.scene_file",
+     "tumble.scene_file.build", "tumble.scene_file.overrides", "tumble.trajectory", "tumble.world"],
+]  # fmt: skip
+KNOWN_ENGINE_IMPORTS = {
+    ("tumble.world", "tumble.control"),
+    ("tumble.world", "tumble.flight"),
+    ("tumble.world", "tumble.flight.native"),
+    ("tumble.world", "tumble.models.mjcf.export"),
+    ("tumble.world", "tumble.scene_file"),
+}
+
+
+def _within(module: str, prefixes) -> bool:
+    return any(module == p or module.startswith(p + ".") for p in prefixes)
+
+
+def _graph_with_packages() -> dict[str, set[str]]:
+    """Module -> the modules it imports, packages included: a package's ``__init__`` that holds code (``flight``'s
+    controllers, the root's names) is a module like any other, reached by ``from .flight import SE3Controller``."""
+    paths = {_module(p): p for p in (SOURCE / "tumble").rglob("*.py")}
+    graph = {}
+    for name, path in paths.items():
+        package = name if path.name == "__init__.py" else name.rpartition(".")[0]
+        found = set()
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.ImportFrom):
+                base = package.split(".")[: len(package.split(".")) - (node.level - 1)] if node.level else []
+                target = ".".join(base + ([node.module] if node.module else []))
+                # ``from . import module`` imports the module; ``from .flight import name``, the package's code.
+                found.update(f"{target}.{a.name}" if f"{target}.{a.name}" in paths else target for a in node.names)
+            elif isinstance(node, ast.Import):
+                found.update(alias.name for alias in node.names)
+        graph[name] = {m for m in found if m in paths and m != name}
+    return graph
+
+
+def _engine_imports_above(graph: dict[str, set[str]]) -> set[tuple[str, str]]:
+    return {(m, t) for m, targets in graph.items() if _within(m, ENGINE) for t in targets if _within(t, ABOVE_ENGINE)}
+
+
+def test_the_layer_scan_sees_a_function_level_import_of_a_package():
+    graph = _graph_with_packages()
+    assert "tumble.flight.native" in graph["tumble.world"]  # imported inside World._native_flights
+    assert _engine_imports_above({"tumble.world": {"tumble.cli", "tumble.state"}}) == {("tumble.world", "tumble.cli")}
+
+
+def test_no_import_circles_counting_packages_and_function_level_imports():
+    assert sorted(_cycles(_graph_with_packages())) == sorted(KNOWN_CIRCLES)
+
+
+def test_the_engine_imports_no_vehicle_controller_model_file_scene_file_or_cli():
+    assert _engine_imports_above(_graph_with_packages()) == KNOWN_ENGINE_IMPORTS
+
+
 # --- tests that assert something ------------------------------------------------------------------------------
 
 _CHECKING_CALLS = ("raises", "warns", "fail", "deprecated_call", "importorskip", "skip", "xfail")
