@@ -10,9 +10,8 @@
 
 from __future__ import annotations
 
-__version__ = "0.1.0"
-
 from . import actuators, control, mass, rotation, sensors, shapes, vehicles, wind
+from ._version import __version__
 from .batch import Batch
 from .errors import SimulationError
 from .handles import Body, Joint

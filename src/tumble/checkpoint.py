@@ -191,7 +191,7 @@ def save_world(world, path: str | os.PathLike) -> Path:
 
     The file is written next to ``path`` and renamed over it, so an interrupted save never leaves half a file.
     """
-    from . import __version__
+    from ._version import __version__
 
     path = Path(path)
     if path.suffix.lower() in (".h5", ".hdf5", ".he5"):

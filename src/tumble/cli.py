@@ -674,7 +674,7 @@ class _Parser(argparse.ArgumentParser):
 def _version() -> str:
     import platform
 
-    from . import __version__
+    from ._version import __version__
 
     return f"tumble {__version__} (Python {platform.python_version()})"
 

@@ -62,7 +62,7 @@ def _scene_dict(scene) -> dict | None:
 
 def run_metadata(world, *, dt: float | None, every: int, scene: dict | None) -> dict:
     """What a trajectory file says about the run that made it (``docs/files.md``)."""
-    from . import __version__
+    from ._version import __version__
 
     model = world.model
     metadata = {

@@ -121,7 +121,7 @@ class Trajectory:
         omega = _angular_velocities(model, quat, angmom)
         mass, inertia = model.body_mass, model.body_inertia_local
         potential = diagnostics.potential_energy(mass, com, model.gravity).sum(axis=-1)  # before com becomes origins
-        from . import __version__
+        from ._version import __version__
 
         return cls(
             time=np.concatenate([[initial.time], times]),

@@ -110,8 +110,8 @@ KNOWN_CIRCLES = [
     ["tumble.articulation", "tumble.models.build", "tumble.models.mjcf", "tumble.models.mjcf.springs",
      "tumble.models.urdf", "tumble.models.urdf.reader"],
     ["tumble.flight", "tumble.vehicles"],
-    ["tumble", "tumble.batch", "tumble.checkpoint", "tumble.models.build_world", "tumble.scene_file",
-     "tumble.scene_file.build", "tumble.scene_file.overrides", "tumble.trajectory", "tumble.world"],
+    ["tumble.models.build_world", "tumble.scene_file", "tumble.scene_file.build", "tumble.scene_file.overrides",
+     "tumble.world"],
 ]  # fmt: skip
 KNOWN_ENGINE_IMPORTS = {
     ("tumble.world", "tumble.control"),
