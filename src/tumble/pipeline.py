@@ -48,7 +48,7 @@ from .params import Integrator, Params
 from .scratch import Scratch
 from .state import State
 
-__all__ = ["simulate_steps", "contact_step"]
+__all__ = ["advance_clock", "contact_step", "simulate_steps"]
 
 
 def simulate_steps(
@@ -79,7 +79,7 @@ def simulate_steps(
             model, state, inputs.body_force, inputs.body_torque, acts, scratch, h, n_steps, method, recording,
             record_every,
         )  # fmt: skip
-        _advance_clock(state, h, steps_done)
+        advance_clock(state, h, steps_done)
         _advance_motors(acts, steps_done * h)
     # The applied loads act in the first step; one that failed drops them too (the world keeps its state from
     # before it), or a load that makes every step overflow (RK4 sums four stages of it) would leave it stuck.
@@ -93,7 +93,7 @@ def _advance_motors(acts: ActuatorArrays, elapsed: float) -> None:
         advance_motors(acts, elapsed)
 
 
-def _advance_clock(state: State, h: float, steps: int) -> None:
+def advance_clock(state: State, h: float, steps: int) -> None:
     # Accumulate time step by step so that simulate(n steps) and n calls of step() agree bit for bit.
     time = state.time
     for _ in range(steps):
@@ -121,7 +121,7 @@ def _contact_steps(model, state, inputs, params, scratch, h, n_steps, recording,
         if bad >= 0:
             state.assign(before)
             return step, bad
-        _advance_clock(state, h, 1)
+        advance_clock(state, h, 1)
         _advance_motors(acts, h)
         if record_every > 0 and (step + 1) % record_every == 0:
             frame = (step + 1) // record_every - 1

@@ -253,9 +253,11 @@ class Quadrotor:
         commands ``controller.update(t, trajectory(t))``. Returns the world controller's handle (``.remove()``).
         A controller that returns rotor speeds that are not four finite numbers stops the run with a
         :class:`~tumble.SimulationError` naming it and the time."""
-        from .flight import fly
+        from .flight.attach import fly
 
-        return fly(self, controller, trajectory, rate)
+        handle = fly(self, controller, trajectory, rate)
+        self._flight = handle.callback.flight
+        return handle
 
     def __repr__(self) -> str:
         return f"<Quadrotor {self.body.name or self.body.index!r} ({self.layout} layout, {self.params['mass']:g} kg)>"

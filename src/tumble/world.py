@@ -33,15 +33,14 @@ from ._validate import (
 )
 from .actuators import Actuation, Actuator
 from .builder import ModelBuilder, ShapeSpec
-from .control import Controller, Controllers, StepClock, controller_failed
+from .controllers import Controller, Controllers, StepClock
 from .errors import SimulationError
-from .flight import bad_rotor_speeds
 from .handles import Body, Joint
 from .inputs import Inputs
 from .mass import MassProperties, require_invertible
 from .model import Model
 from .params import DEFAULT_SOLVER, INTEGRATOR_NAMES, Params, SolverSettings
-from .pipeline import simulate_steps
+from .pipeline import advance_clock, simulate_steps
 from .queries import Contacts, RayHit
 from .rotation import quat_rotate
 from .scratch import Scratch
@@ -676,17 +675,17 @@ class World:
             self._params.solver.substeps_for(dt)
         return dt
 
-    def _controlled_step(self, dt: float, flights=None) -> int:
-        """The controllers that are due (or the compiled ``flights`` in their place), one step, the sensors'
-        samples: the failing body's row, or -1.
+    def _controlled_step(self, dt: float, stage=None) -> int:
+        """The controllers that are due (or the compiled ``stage`` in their place), one step, the sensors' samples:
+        the failing body's row, or -1.
 
         Raises:
             SimulationError: a controller raised (before the step: the world is as it was).
         """
-        if flights is None:
+        if stage is None:
             self._controllers.run(self, self._next_step_time(dt), dt)
         else:
-            self._run_flights(flights, self._next_step_time(dt), dt)
+            stage.command(self._model, self._state, self._actuation.arrays, self._next_step_time(dt), dt)
         self._sync()
         self._sensors.before_step(self)
         _, failing = simulate_steps(self._model, self._state, self._inputs, self._params, self._scratch, dt,
@@ -727,10 +726,10 @@ class World:
         t0, initial = self._state.time, self._state.copy()
         recording = Trajectory.allocate_recording(self._state.body_count, n_steps // record_every)
         controller_error = None
-        flights = self._native_flights()
-        if flights is not None:
-            steps_done, failing, controller_error = self._simulate_flights(flights, dt, n_steps, recording,
-                                                                           int(record_every))  # fmt: skip
+        stage = self._compiled_stage()
+        if stage is not None:
+            steps_done, failing, controller_error = self._simulate_stage(stage, dt, n_steps, recording,
+                                                                         int(record_every))  # fmt: skip
         elif self._controllers or self._sensors or not isinstance(self._wind, (Constant, type(None))):
             steps_done, failing, controller_error = self._simulate_stepwise(dt, n_steps, recording, int(record_every))
         else:
@@ -756,81 +755,38 @@ class World:
             raise error
         return trajectory
 
-    def _native_flights(self):
-        """The table of the world's controllers when every one is a flight the kernels run themselves
-        (``tumble.flight.native``: SE(3) on a known reference); else None."""
+    def _compiled_stage(self):
+        """The compiled stage that runs every controller of the world in their place (``Controllers.compiled_stage``),
+        or None."""
         if not self._controllers:
             return None
-        from .flight.native import flight_table
-
         self._sync()
-        self._actuation.for_bodies(self._model.body_com_local)  # the rotors' rows in the arrays
-        return flight_table(self, list(self._controllers))
+        self._actuation.for_bodies(self._model.body_com_local)  # the actuators' rows in the arrays
+        return self._controllers.compiled_stage(self)
 
-    def _simulate_flights(self, table, dt: float, n_steps: int, recording, record_every: int):
-        """The steps with the flights of ``table`` between them, compiled: ``(steps_done, failing_body, error)`` as
+    def _simulate_stage(self, stage, dt: float, n_steps: int, recording, record_every: int):
+        """The steps with the compiled ``stage`` between them: ``(steps_done, failing_body, error)`` as
         :meth:`_simulate_stepwise`. Free bodies (no sensors, a constant wind) take all the steps in one call; else
-        each step is a call, and the flights one more (instead of a Python controller each)."""
+        each step is a call, and the stage one more (instead of a Python controller each)."""
         if self._model.has_constraints or self._sensors or not isinstance(self._wind, (Constant, type(None))):
-            result = self._simulate_stepwise(dt, n_steps, recording, record_every, flights=table)
+            result = self._simulate_stepwise(dt, n_steps, recording, record_every, stage=stage)
         else:
-            result = self._fly_free_bodies(table, dt, n_steps, recording, record_every)
-        for k, controller in enumerate(self._controllers):
-            controller.calls += int(table.calls[k])
-            controller._next_tick = int(table.next_tick[k])
-            integral = controller._flight.controller._integral
-            integral.value[:] = table.integral[k]
-            integral._last_time = None if np.isnan(table.last_time[k]) else float(table.last_time[k])
+            acts = self._actuators_for_step(dt)
+            state = self._state
+            clock = self._clock.count(state.time, state.step_count, dt)
+            result = stage.fly_free(self._model, state, self._inputs, acts, self._scratch, recording, dt, n_steps,
+                                    int(self._params.resolve_integrator(False)), record_every, clock)  # fmt: skip
+            advance_clock(state, dt, result[0])
+            self._inputs.clear()  # as simulate_steps: used, or dropped with a failed first step
+        stage.finish()
         return result
 
-    def _run_flights(self, table, t: float, dt: float) -> None:
-        """The flights of ``table`` that are due before the step of ``dt`` from ``t`` (``flight.native``).
-
-        Raises:
-            SimulationError: a flight asked for rotor speeds that are not finite (the world is as it was).
-        """
-        from .flight.native import command_flights
-
-        state, speeds = self._state, np.zeros(4)
-        failing = command_flights(table, self._model.gravity, self._actuation.arrays, state.body_pos, state.body_quat,
-                                  state.body_linvel, state.body_angmom, t, dt, np.zeros((5, 3)), speeds,
-                                  np.zeros(3))  # fmt: skip
-        if failing >= 0:
-            raise self._flight_failed(table, failing, speeds, t)
-
-    def _flight_failed(self, table, flight: int, speeds: np.ndarray, t: float) -> SimulationError:
-        handle = list(self._controllers)[flight]
-        error = bad_rotor_speeds(handle._flight.controller, speeds, t)
-        return controller_failed(handle.name, error, t, self._state.step_count)
-
-    def _fly_free_bodies(self, table, dt: float, n_steps: int, recording, record_every: int):
-        """Free bodies only: every step and flight in one compiled call (``flight.native.fly_steps``)."""
-        from .flight.native import fly_steps
-        from .pipeline import _advance_clock
-
-        acts = self._actuators_for_step(dt)
-        self._next_step_time(dt)  # rebase the counted clock if it must be
-        origin_time, origin_step, _ = self._clock._origin
-        model, state, inputs, scratch = self._model, self._state, self._inputs, self._scratch
-        speeds = np.zeros(4)
-        steps, failing, flight = fly_steps(
-            table, model.body_arrays, model.gravity, inputs.body_force, inputs.body_torque,
-            np.zeros_like(inputs.body_force), acts, state.body_pos, state.body_quat, state.body_linvel,
-            state.body_angmom, scratch.backup, scratch.no_recording, recording, dt, n_steps,
-            int(self._params.resolve_integrator(False)), record_every, origin_time, state.step_count - origin_step,
-            np.zeros((5, 3)), speeds,
-        )  # fmt: skip
-        _advance_clock(state, dt, steps)
-        inputs.clear()  # as simulate_steps: used, or dropped with a failed first step
-        error = self._flight_failed(table, flight, speeds, self._next_step_time(dt)) if flight >= 0 else None
-        return steps, failing, error
-
-    def _simulate_stepwise(self, dt: float, n_steps: int, recording, record_every: int, flights=None):
-        """Step by step from Python, the controllers (or the compiled ``flights``) before each step and the sensors
+    def _simulate_stepwise(self, dt: float, n_steps: int, recording, record_every: int, stage=None):
+        """Step by step from Python, the controllers (or the compiled ``stage``) before each step and the sensors
         after it: ``(steps_done, failing_body, error)``."""
         for step in range(n_steps):
             try:
-                failing = self._controlled_step(dt, flights)
+                failing = self._controlled_step(dt, stage)
             except SimulationError as error:
                 return step, -1, error
             if self._state.body_count != recording.pos.shape[1]:

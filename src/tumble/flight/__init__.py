@@ -10,7 +10,7 @@ mixer (``Mixer.allocate``, which keeps the thrust first under saturation).
 
 from __future__ import annotations
 
-from typing import NamedTuple
+import math
 
 import numpy as np
 
@@ -19,7 +19,7 @@ from .._validate import as_array, as_float, as_quaternion, as_vector3
 from ..rotation import quat_to_matrix
 from . import kernels
 
-__all__ = ["Autopilot", "CascadedPID", "SE3Controller", "fly"]
+__all__ = ["Autopilot", "CascadedPID", "SE3Controller", "bad_rotor_speeds"]
 
 
 def desired_rotation(force, yaw: float) -> np.ndarray:
@@ -156,6 +156,16 @@ class SE3Controller:
     def reset(self) -> None:
         """Forget the integral of the position error."""
         self._integral.reset()
+
+    def _integral_state(self) -> tuple[np.ndarray, float]:
+        """``(∫e_x dt, the time of its last update or NaN)``, as the compiled flights carry it (``flight.native``)."""
+        last = self._integral._last_time
+        return self._integral.value.copy(), math.nan if last is None else last
+
+    def _load_integral_state(self, value: np.ndarray, last_time: float) -> None:
+        """Take the integral back from the compiled flights (:meth:`_integral_state`'s form)."""
+        self._integral.value[:] = value
+        self._integral._last_time = None if math.isnan(last_time) else float(last_time)
 
     def update(self, t: float, reference) -> np.ndarray:
         """Rotor speeds (4,) [rad/s] that steer the vehicle towards ``reference`` (a trajectory's ``traj(t)``)."""
@@ -310,33 +320,3 @@ def bad_rotor_speeds(controller, speeds: np.ndarray, t: float) -> ValueError:
     """What a flight's controller returned that cannot be commanded."""
     return ValueError(f"{type(controller).__name__}.update returned {speeds.tolist()!r} at t = {t:.6g} s, not four "
                       "finite rotor speeds")  # fmt: skip
-
-
-class Flight(NamedTuple):
-    """What :func:`fly` attached to a vehicle: the controller, the trajectory, the rate and the world controller."""
-
-    controller: object
-    trajectory: object
-    rate: float | None
-    handle: object
-    quad: object
-
-
-def fly(quad, controller, trajectory, rate: float | None = None):
-    """Attach ``controller`` following ``trajectory`` to ``quad``'s world (``Quadrotor.fly``); returns the world
-    controller's handle."""
-    if not callable(getattr(controller, "update", None)):
-        raise TypeError(f"controller must have update(t, reference) -> rotor speeds, got {controller!r}")
-    if not callable(trajectory):
-        raise TypeError(f"trajectory must be callable as trajectory(t) -> reference, got {trajectory!r}")
-    name = f"{type(controller).__name__} on {type(trajectory).__name__}"
-
-    def follow(world, t):
-        speeds = np.asarray(controller.update(t, trajectory(t)), dtype=float)
-        if speeds.shape != (4,) or not np.all(np.isfinite(speeds)):
-            raise bad_rotor_speeds(controller, speeds, t)
-        quad.command_rotor_speeds(speeds)
-
-    handle = quad.world.add_controller(follow, rate=rate, name=name)
-    quad._flight = handle._flight = Flight(controller, trajectory, rate, handle, quad)
-    return handle

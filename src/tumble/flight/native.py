@@ -1,7 +1,8 @@
 """Flights in the kernels: when a world's only controllers are ``quad.fly(SE3Controller(...), Hover | Circle |
 Lissajous | MinimumSnap)``, ``world.simulate`` evaluates them with :func:`command_flights`, one kernel call for all
 of them, instead of a Python controller each; a world of free bodies (no contacts or joints, no sensors, a constant
-wind) takes every step and flight in one call (:func:`fly_steps`).
+wind) takes every step and flight in one call (:func:`fly_steps`). :class:`NativeFlights` is the compiled stage
+the world's controllers hand the run to (``tumble.controllers.Controllers.compiled_stage``).
 
 It does what the step-by-step path does, in the same order and with the same kernels: at each step's counted start
 time the flights that are due evaluate their reference (``reference_derivatives``) and the SE(3) law
@@ -17,16 +18,15 @@ from typing import NamedTuple
 import numpy as np
 
 from .._jit import kernel
+from ..controllers import TICK_TOLERANCE, controller_failed
 from ..dynamics.actuation import advance_motors
 from ..dynamics.integrate import advance_rows
 from ..math3d import store3, store4
 from ..references import Circle, Hover, Lissajous, MinimumSnap
-from . import SE3Controller
+from . import SE3Controller, bad_rotor_speeds
 from .kernels import reference_derivatives, se3_rotor_speeds
 
-__all__ = ["FlightTable", "command_flights", "flight_table", "fly_steps"]
-
-_TICK_TOLERANCE = 1e-9  # as tumble.control's: a tick within a billionth of a step counts as reached
+__all__ = ["FlightTable", "NativeFlights", "command_flights", "flight_table", "fly_steps"]
 
 
 class FlightTable(NamedTuple):
@@ -66,7 +66,7 @@ def flight_table(world, controllers) -> FlightTable | None:
     the kernel can run (an SE(3) controller on a known reference, its vehicle's rotors in the actuator arrays)."""
     rows = []
     for controller in controllers:
-        flight = getattr(controller, "_flight", None)
+        flight = getattr(controller.callback, "flight", None)
         if flight is None or type(flight.controller) is not SE3Controller:
             return None
         reference = _reference_spec(flight.trajectory)
@@ -99,10 +99,8 @@ def flight_table(world, controllers) -> FlightTable | None:
             float,
         ),  # fmt: skip
         feedforward=np.array([law.feedforward for _, law, *_ in rows], np.bool_),
-        integral=np.array([law._integral.value for _, law, *_ in rows], float),
-        last_time=np.array(
-            [math.nan if law._integral._last_time is None else law._integral._last_time for _, law, *_ in rows], float
-        ),  # fmt: skip
+        integral=np.array([law._integral_state()[0] for _, law, *_ in rows], float),
+        last_time=np.array([law._integral_state()[1] for _, law, *_ in rows], float),
         mixer_inverse=np.array([q.mixer.inverse for q, *_ in rows], float),
         k_thrust=np.array([q.params["k_thrust"] for q, *_ in rows], float),
         squared_limits=np.array([q.mixer.squared_limits for q, *_ in rows], float),
@@ -125,7 +123,7 @@ def command_flights(table, gravity, acts, pos, quat, linvel, angmom, t, h, ref, 
     ``integral`` (3,) are scratch."""
     for f in range(table.body.shape[0]):
         rate = table.rate[f]
-        if rate > 0.0 and t < table.next_tick[f] / rate - _TICK_TOLERANCE * h:
+        if rate > 0.0 and t < table.next_tick[f] / rate - TICK_TOLERANCE * h:
             continue
         reference_derivatives(table.kind[f], table.params[f], table.knot_count[f], table.knots[f],
                               table.coefficients[f], t, ref)  # fmt: skip
@@ -155,7 +153,7 @@ def command_flights(table, gravity, acts, pos, quat, linvel, angmom, t, h, ref, 
             acts.command[table.rows[f, k]] = min(max(speeds[k], table.speed_min[f, k]), table.speed_max[f, k])
         table.calls[f] += 1
         if rate > 0.0:
-            table.next_tick[f] = max(table.next_tick[f] + 1, math.floor((t + _TICK_TOLERANCE * h) * rate) + 1)
+            table.next_tick[f] = max(table.next_tick[f] + 1, math.floor((t + TICK_TOLERANCE * h) * rate) + 1)
     return -1
 
 
@@ -194,3 +192,53 @@ def fly_steps(table, bodies, gravity, force, torque, zero, acts, pos, quat, linv
             rec.linvel[frame, :, :] = linvel
             rec.angmom[frame, :, :] = angmom
     return n_steps, -1, -1
+
+
+class NativeFlights:
+    """The compiled stage of a world whose controllers are all native flights (see
+    ``tumble.controllers.Controllers.compiled_stage`` for what a stage does): :func:`command_flights` before each
+    step of a Python loop, or :func:`fly_steps` for every step of a world of free bodies."""
+
+    def __init__(self, controllers: list, table: FlightTable):
+        self._controllers, self._table = controllers, table
+
+    @classmethod
+    def for_world(cls, world, controllers) -> NativeFlights | None:
+        """The stage of ``controllers`` (the world's, in order), or None when one is not a flight it runs."""
+        table = flight_table(world, controllers)
+        if table is None:
+            return None
+        return cls(controllers, table)
+
+    def command(self, model, state, acts, t: float, dt: float) -> None:
+        speeds = np.zeros(4)
+        failing = command_flights(self._table, model.gravity, acts, state.body_pos, state.body_quat, state.body_linvel,
+                                  state.body_angmom, t, dt, np.zeros((5, 3)), speeds, np.zeros(3))  # fmt: skip
+        if failing >= 0:
+            raise self._failed(failing, speeds, t, state.step_count)
+
+    def fly_free(self, model, state, inputs, acts, scratch, recording, dt, n_steps, method, record_every, clock):
+        origin_time, origin_count = clock
+        speeds = np.zeros(4)
+        steps, failing, flight = fly_steps(
+            self._table, model.body_arrays, model.gravity, inputs.body_force, inputs.body_torque,
+            np.zeros_like(inputs.body_force), acts, state.body_pos, state.body_quat, state.body_linvel,
+            state.body_angmom, scratch.backup, scratch.no_recording, recording, dt, n_steps, method, record_every,
+            origin_time, origin_count, np.zeros((5, 3)), speeds,
+        )  # fmt: skip
+        error = None
+        if flight >= 0:  # before the step ``steps``, at its counted start time
+            error = self._failed(flight, speeds, origin_time + (origin_count + steps) * dt, state.step_count + steps)
+        return steps, failing, error
+
+    def finish(self) -> None:
+        table = self._table
+        for k, controller in enumerate(self._controllers):
+            controller.count_calls(table.calls[k], table.next_tick[k])
+            law = controller.callback.flight.controller
+            law._load_integral_state(table.integral[k], table.last_time[k])
+
+    def _failed(self, flight: int, speeds: np.ndarray, t: float, step: int):
+        controller = self._controllers[flight]
+        return controller_failed(controller.name, bad_rotor_speeds(controller.callback.flight.controller, speeds, t),
+                                 t, step)  # fmt: skip
