@@ -30,8 +30,8 @@ def overlap_depths(world: World, rate: float, duration: float) -> tuple[float, f
     for _ in range(round(duration * rate)):
         world.step(1.0 / rate)
         contacts = world.contacts()
-        pairs = list(zip(contacts.shape_a.tolist(), contacts.shape_b.tolist()))
-        overlapping = {pair for pair, separation in zip(pairs, contacts.separation) if separation < 0.0}
+        pairs = list(zip(contacts.shape_a.tolist(), contacts.shape_b.tolist(), strict=True))
+        overlapping = {pair for pair, separation in zip(pairs, contacts.separation, strict=True) if separation < 0.0}
         as_built = overlapping if as_built is None else as_built & overlapping
         counted = np.array([pair not in as_built for pair in pairs], dtype=bool)
         on_static = static[contacts.body_a] | static[contacts.body_b]

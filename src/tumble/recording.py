@@ -30,6 +30,7 @@ from ._validate import as_count, as_float, step_count
 from .errors import SimulationError
 from .trajectory import Trajectory
 from .trajectory_io import FRAME_ARRAYS
+from .vehicles import quadrotors
 
 __all__ = ["TrajectoryWriter", "VehicleLog", "record", "default_chunk_frames"]
 
@@ -261,7 +262,7 @@ class VehicleLog:
     def __init__(self, world, every: int):
         self.every = every
         self._start = world.step_count
-        self._vehicles = list(world._vehicles)
+        self._vehicles = quadrotors(world)
         self._samples: list[list[np.ndarray]] = []
         self._last_step: int | None = None
         self._handle = world.add_controller(lambda world, t: self.sample(world), name="vehicle log")
@@ -329,7 +330,7 @@ def record(world, duration: float, dt: float, path, *, every: int = 1, chunk_fra
     n_steps = step_count(duration, dt)
     writer = TrajectoryWriter(path, world, every=every, chunk_frames=chunk_frames, scene=scene, dt=dt,
                               compression=compression)  # fmt: skip
-    log = VehicleLog(world, writer.every) if world._vehicles else None
+    log = VehicleLog(world, writer.every) if quadrotors(world) else None
     try:
         return _record_chunks(world, n_steps, dt, writer, log, callback, load)
     finally:

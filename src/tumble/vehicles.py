@@ -28,7 +28,7 @@ from .flight.kernels import allocate_speeds
 from .mass import MassProperties
 from .shapes import Box, Sphere
 
-__all__ = ["CRAZYFLIE", "HUMMINGBIRD", "Mixer", "Quadrotor", "quadrotor_params", "rotor_hubs"]
+__all__ = ["CRAZYFLIE", "HUMMINGBIRD", "Mixer", "Quadrotor", "quadrotor_params", "quadrotors", "rotor_hubs"]
 
 _PARAMETER_NAMES = ("mass", "inertia", "arm_length", "k_thrust", "k_moment", "k_drag", "k_inflow", "speed_min",
                     "speed_max", "time_constant", "rotor_directions", "drag_coefficients", "kp_att",
@@ -184,7 +184,7 @@ class Quadrotor:
         self.mixer = Mixer(hubs, p["rotor_directions"], p["k_thrust"], p["k_moment"], p["speed_min"], p["speed_max"])
         self._autopilot = None
         self._flight = None  # what fly() attached (tumble.flight.Flight)
-        world._vehicles.append(self)
+        world.attach(self)
 
     @property
     def rotor_speeds(self) -> np.ndarray:
@@ -261,3 +261,8 @@ class Quadrotor:
 
     def __repr__(self) -> str:
         return f"<Quadrotor {self.body.name or self.body.index!r} ({self.layout} layout, {self.params['mass']:g} kg)>"
+
+
+def quadrotors(world) -> list[Quadrotor]:
+    """The quadrotors attached to ``world``, in the order they were made (none for ``None``)."""
+    return [] if world is None else [item for item in world.attachments if isinstance(item, Quadrotor)]

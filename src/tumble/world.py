@@ -233,7 +233,7 @@ class World:
         self._actuation = Actuation()
         self._sensors = Sensors()
         self._wind: Wind | None = None
-        self._vehicles: list = []  # tumble.vehicles.Quadrotor, each one body with its actuators
+        self._attachments: list = []  # what attach() registered: vehicles (tumble.vehicles.Quadrotor)
         self._joint_drives = None  # tumble.joint_drives.JointDrives, made with the first joint actuator
 
     @classmethod
@@ -469,6 +469,19 @@ class World:
     @wind.setter
     def wind(self, value) -> None:
         self._wind = as_wind(value)
+
+    def attach(self, attachment) -> None:
+        """Register ``attachment``, an object that plugs into this world's step through its public interface (a
+        vehicle: ``tumble.vehicles.Quadrotor`` attaches itself). The viewer, recordings, scene files and MJCF export
+        find vehicles here. ``docs/step.md`` says what an attachment may add to the step."""
+        if attachment in self._attachments:
+            raise ValueError(f"{attachment!r} is attached to this world already")
+        self._attachments.append(attachment)
+
+    @property
+    def attachments(self) -> tuple:
+        """What :meth:`attach` registered, in order."""
+        return tuple(self._attachments)
 
     @property
     def controllers(self) -> list[Controller]:

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from tumble import scene_file
-from tumble.vehicles import CRAZYFLIE
+from tumble.vehicles import CRAZYFLIE, quadrotors
 
 FEET = 0.4 * CRAZYFLIE["arm_length"]  # the feet's depth below the centre of mass
 QUADROTOR_SCENES = sorted(p.stem for p in scene_file.shipped() if p.stem.startswith("quadrotor_"))
@@ -22,7 +22,7 @@ def fly(name: str, every: int = 1):
     world = loaded.world
     recording = world.simulate(loaded.run.duration, loaded.run.dt, record_every=every)
     errors = []
-    for quad in world._vehicles:
+    for quad in quadrotors(world):
         reference = np.array([quad._flight.trajectory(t)["position"] for t in recording.time])
         errors.append(np.linalg.norm(recording.position[:, quad.body.index] - reference, axis=1))
     return world, recording, errors
@@ -35,7 +35,7 @@ def test_the_six_quadrotor_scenes_are_shipped():
 
 def test_tilt_recovery_rights_itself_above_the_ground():
     world, recording, (error,) = fly("quadrotor_tilt_recovery")
-    i = world._vehicles[0].body.index
+    i = quadrotors(world)[0].body.index
     assert recording.position[:, i, 2].min() > 0.8 and error[-1] < 1e-3
 
 
@@ -43,7 +43,7 @@ def test_altitude_step_settles_in_the_documented_time():
     world, recording, (error,) = fly("quadrotor_altitude_step")
     outside = np.flatnonzero(error > 0.02)
     assert recording.time[outside[-1] + 1] <= 2.1 + 1e-9
-    assert recording.position[:, world._vehicles[0].body.index, 2].max() < 2.0 + 1e-4
+    assert recording.position[:, quadrotors(world)[0].body.index, 2].max() < 2.0 + 1e-4
 
 
 def test_waypoint_square_is_flown_within_a_few_centimetres():
@@ -61,7 +61,7 @@ def test_figure_eight_in_dryden_wind_stays_close():
 
 def test_landing_comes_to_rest_on_its_feet_without_bouncing():
     world, recording, _ = fly("quadrotor_landing")
-    quad = world._vehicles[0]
+    quad = quadrotors(world)[0]
     z = recording.position[:, quad.body.index, 2]
     touch = np.argmax(z < FEET + 1e-4)
     assert 0 < touch and recording.time[touch] < 4.0  # touched down as the path reached the ground
@@ -73,7 +73,7 @@ def test_landing_comes_to_rest_on_its_feet_without_bouncing():
 
 def test_two_vehicles_pass_without_touching():
     world, recording, errors = fly("quadrotor_passing")
-    a, b = (quad.body.index for quad in world._vehicles)
+    a, b = (quad.body.index for quad in quadrotors(world))
     gap = np.linalg.norm(recording.position[:, a] - recording.position[:, b], axis=1)
     assert gap.min() > 0.25  # their collision shapes reach 4.7 cm from their centres
     assert max(error.max() for error in errors) < 0.1

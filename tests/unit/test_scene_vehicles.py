@@ -11,6 +11,7 @@ import pytest
 from tumble import scene_file, wind
 from tumble.control import CascadedPID, MinimumSnap, SE3Controller
 from tumble.scene_file import SceneError
+from tumble.vehicles import quadrotors
 
 SCENE = """
 [world]
@@ -50,7 +51,7 @@ seed = 3
 
 def test_vehicles_are_built_as_the_api_builds_them():
     world = scene_file.from_dict(tomllib.loads(SCENE)).world
-    cf, hb, free = world._vehicles
+    cf, hb, free = quadrotors(world)
     assert cf.body.name == "cf" and cf.params["mass"] == 0.03 and cf.layout == "x"
     assert isinstance(cf._flight.controller, SE3Controller) and cf._flight.rate == 100.0
     np.testing.assert_array_equal(cf._flight.controller.ki_pos, [1.0, 1.0, 1.0])
@@ -66,7 +67,7 @@ def test_vehicles_are_built_as_the_api_builds_them():
 def test_to_scene_writes_vehicles_and_wind_back_and_the_copy_flies_the_same():
     world = scene_file.from_dict(tomllib.loads(SCENE)).world
     again = scene_file.from_dict(tomllib.loads(scene_file.dumps(world.to_scene(dt=0.01)))).world
-    assert [q.body.name for q in again._vehicles] == ["cf", "hb", "open"]
+    assert [q.body.name for q in quadrotors(again)] == ["cf", "hb", "open"]
     for w in (world, again):
         w.simulate(0.3, 0.01)
     np.testing.assert_allclose(again.state.body_pos, world.state.body_pos, atol=1e-12)

@@ -10,7 +10,7 @@ import pytest
 
 import tumble
 from tumble.control import CascadedPID, Circle, Hover, Lissajous, MinimumSnap, SE3Controller
-from tumble.vehicles import CRAZYFLIE, HUMMINGBIRD, Quadrotor, quadrotor_params
+from tumble.vehicles import CRAZYFLIE, HUMMINGBIRD, Quadrotor, quadrotor_params, quadrotors
 
 
 def quad(layout="x", params=CRAZYFLIE, **kw) -> Quadrotor:
@@ -264,3 +264,14 @@ def test_reference_constructors_refuse_bad_input():
         Circle((0, 0), 1.0, 0.2)
     with pytest.raises(TypeError, match="t must be a real number"):
         Hover((0, 0, 0))("now")
+
+
+def test_a_quadrotor_attaches_itself_once_and_the_world_lists_it():
+    world = tumble.World()
+    a = Quadrotor(world, name="a")
+    b = Quadrotor(world, position=(1.0, 0.0, 0.0), name="b")
+    assert world.attachments == (a, b)
+    assert quadrotors(world) == [a, b] and quadrotors(None) == []
+    with pytest.raises(ValueError, match="attached to this world already"):
+        world.attach(a)
+    assert world.attachments == (a, b)

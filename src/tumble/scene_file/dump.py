@@ -14,6 +14,7 @@ import numpy as np
 
 from ..rotation import quat_multiply, quat_rotate
 from ..shapes import Box, Capsule, ConvexHull, Cylinder, Plane, Sphere, TriMesh
+from ..vehicles import quadrotors
 from .vehicles import vehicle_to_scene, wind_to_scene
 
 __all__ = ["body_names", "joint_entry", "world_to_scene"]
@@ -165,7 +166,7 @@ def world_to_scene(world, *, dt: float | None = None, duration: float | None = N
         settings["dt"] = float(dt)
     if duration is not None:
         settings["duration"] = float(duration)
-    vehicles = {quad.body.index: quad for quad in world._vehicles}
+    vehicles = {quad.body.index: quad for quad in quadrotors(world)}
     scene = {
         "world": settings,
         "bodies": [

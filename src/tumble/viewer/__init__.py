@@ -23,6 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..vehicles import quadrotors
 from .geometry import fallback_geometry, scene_geometry
 from .page import build_data, render_page
 
@@ -45,7 +46,7 @@ def _channels_for(trajectory, world) -> dict:
     """The recording's channels; where a vehicle of ``world`` has no reference there, its flight's trajectory at
     the recorded times (a ``world.simulate`` recording has no channels)."""
     channels = dict(trajectory.channels)
-    for quad in getattr(world, "_vehicles", ()):
+    for quad in quadrotors(world):
         key = f"vehicle/{quad.body.name or f'#{quad.body.index}'}/reference"
         if key not in channels and quad._flight is not None:
             reference = quad._flight.trajectory

@@ -33,6 +33,7 @@ import numpy as np
 
 from ..rotation import quat_multiply, quat_rotate
 from ..shapes import Box, Capsule, ConvexHull, Cylinder, Plane, Sphere, TriMesh
+from ..vehicles import quadrotors
 
 __all__ = ["scene_geometry", "fallback_geometry", "body_radius", "plane_quads", "check_geometry"]
 
@@ -109,7 +110,7 @@ def _vehicle_parts(world) -> tuple[list[dict], list[dict]]:
     and a rotor disc over each hub (drawn only; positions in the body frame from its origin, as the rotors'), and
     the vehicle itself (body, name, hubs, spins, rotor radius) for its blades and reference path."""
     parts, vehicles = [], []
-    for quad in world._vehicles:
+    for quad in quadrotors(world):
         i, arm = quad.body.index, quad.params["arm_length"]
         hubs = []
         for rotor in quad.rotors:

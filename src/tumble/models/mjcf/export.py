@@ -28,6 +28,7 @@ import numpy as np
 from ...rotation import quat_conjugate, quat_multiply, quat_rotate, quat_to_matrix
 from ...scene_file.dump import body_names, joint_entry
 from ...shapes import Box, Capsule, ConvexHull, Cylinder, Plane, Sphere
+from ...vehicles import quadrotors
 from .frames import quat_z_to
 
 __all__ = ["world_to_mjcf"]
@@ -81,7 +82,7 @@ def _geoms(world, body, name: str, assets: list[str], pose=None) -> str:
 
 
 def _refuse_what_mjcf_cannot_say(world, joints: list[dict]) -> None:
-    if world._vehicles or world.actuators:
+    if quadrotors(world) or world.actuators:
         raise ValueError("to_mjcf: the world has vehicles or rotors and thrusters, which are not written to MJCF (yet)")
     drives = [] if world._joint_drives is None else world._joint_drives.drives
     for drive in drives:
