@@ -5,7 +5,7 @@ copy-major, so that ``body_pos.reshape(copies * bodies, 3)`` is a view of the sa
 ``c``'s ``world.state.body_pos``. The model is the world's, with per-copy overrides (gravity, masses, friction,
 restitution, joint drive targets) packed as ``(copies, ...)`` tables beside it.
 
-A step runs the world's own pipeline (``pipeline.simulate_steps``), not a second engine: a block of copies is one
+A step runs the world's own pipeline (``runner.simulate_steps``), not a second engine: a block of copies is one
 world whose rows are the copies' rows one copy after the other (``batch_rows.py``), stepped by one call per stage
 for all its copies.
 
@@ -33,7 +33,7 @@ from .dynamics.actuation import ActuatorArrays
 from .dynamics.integrate import _thread_pool, threads
 from .errors import SimulationError
 from .inputs import Inputs
-from .pipeline import simulate_steps
+from .runner import simulate_steps
 from .scratch import Scratch
 from .state import State
 

@@ -25,7 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
-from . import trajectory_io
+from . import trajectory_io, world_stepping
 from ._validate import as_count, as_float, step_count
 from .errors import SimulationError
 from .trajectory import Trajectory
@@ -326,7 +326,7 @@ def record(world, duration: float, dt: float, path, *, every: int = 1, chunk_fra
             chunk written before the interruption.
     """
     duration = as_float("duration", duration, positive=True)
-    dt = world._as_step(dt)
+    dt = world_stepping.checked_step(world, dt)
     n_steps = step_count(duration, dt)
     writer = TrajectoryWriter(path, world, every=every, chunk_frames=chunk_frames, scene=scene, dt=dt,
                               compression=compression)  # fmt: skip

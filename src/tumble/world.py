@@ -14,33 +14,28 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from . import diagnostics, portable
+from . import diagnostics, portable, world_stepping
 from ._validate import (
     MAX_COUNT,
     as_array,
-    as_count,
     as_filter,
     as_float,
     as_material,
     as_quaternion,
     as_rate,
-    as_step,
     as_unit_vector3,
     as_vector3,
     finite_result,
     mass_or_density,
-    step_count,
 )
 from .actuators import Actuation, Actuator
 from .builder import ModelBuilder, ShapeSpec
 from .controllers import Controller, Controllers, StepClock
-from .errors import SimulationError
 from .handles import Body, Joint
 from .inputs import Inputs
 from .mass import MassProperties, require_invertible
 from .model import Model
 from .params import DEFAULT_SOLVER, INTEGRATOR_NAMES, Params, SolverSettings
-from .pipeline import advance_clock, simulate_steps
 from .queries import Contacts, RayHit
 from .rotation import quat_rotate
 from .scratch import Scratch
@@ -48,7 +43,7 @@ from .sensors import Sensor, Sensors
 from .shapes import Plane, Shape, TriMesh
 from .state import State
 from .trajectory import Trajectory
-from .wind import Constant, Wind, as_wind
+from .wind import Wind, as_wind
 
 __all__ = ["World"]
 
@@ -663,7 +658,7 @@ class World:
     def step_count(self) -> int:
         return self._state.step_count
 
-    # --- stepping -----------------------------------------------------------------------------------
+    # --- stepping (world_stepping.py: the controllers, the compiled stages and sensors around the runner) -----
 
     def step(self, dt: float) -> None:
         """Advance one step of ``dt`` seconds. Applied forces act during this step only.
@@ -674,56 +669,7 @@ class World:
             SimulationError: the step produced a non-finite value; the world keeps its state from before, and the
                 loads applied for the step are dropped (so that the next step can succeed).
         """
-        dt = self._as_step(dt)
-        failing = self._controlled_step(dt)
-        if failing >= 0:
-            raise self._simulation_error(failing)
-
-    def _as_step(self, dt) -> float:
-        """``dt`` checked as a step of this world: one that advances its time and, where the contact solver runs,
-        needs no more substeps than it allows (before any controller runs or state changes)."""
-        dt = as_step("dt", dt, self._state.time)
-        self._sync()
-        if self._model.has_constraints:
-            self._params.solver.substeps_for(dt)
-        return dt
-
-    def _controlled_step(self, dt: float, stage=None) -> int:
-        """The controllers that are due (or the compiled ``stage`` in their place), one step, the sensors' samples:
-        the failing body's row, or -1.
-
-        Raises:
-            SimulationError: a controller raised (before the step: the world is as it was).
-        """
-        if stage is None:
-            self._controllers.run(self, self._next_step_time(dt), dt)
-        else:
-            stage.command(self._model, self._state, self._actuation.arrays, self._next_step_time(dt), dt)
-        self._sync()
-        self._sensors.before_step(self)
-        _, failing = simulate_steps(self._model, self._state, self._inputs, self._params, self._scratch, dt,
-                                    acts=self._actuators_for_step(dt))  # fmt: skip
-        if failing < 0:
-            self._sensors.sample(self, dt)
-        return failing
-
-    def _next_step_time(self, dt: float) -> float:
-        """The next step's start time as controllers and wind see it: counted, not accumulated."""
-        return self._clock.start_of_next_step(self._state.time, self._state.step_count, dt)
-
-    def _actuators_for_step(self, dt: float):
-        """The actuators' arrays and the wind for the next steps; their bodies are kept awake (thrust that holds a
-        body still must not let it sleep, or a change of wind or command would not reach it)."""
-        if self._wind is not None:
-            self._actuation.wind = self._wind.velocity(self._next_step_time(dt), dt)
-        else:
-            self._actuation.wind = np.zeros(3)
-        acts = self._actuation.for_bodies(self._model.body_com_local)
-        driven = self._actuation.driven_bodies()
-        if driven.size:
-            self._state.body_sleep_time[driven] = 0.0
-            self._state.body_sleeping[driven] = False
-        return acts
+        world_stepping.step(self, dt)
 
     def simulate(self, duration: float, dt: float, record_every: int = 1) -> Trajectory:
         """Take ``round(duration / dt)`` steps in one compiled loop, recording every ``record_every`` steps.
@@ -731,97 +677,7 @@ class World:
         The trajectory starts with the current state. On a :class:`SimulationError` the world keeps its last
         good state and the error's ``trajectory`` holds the frames recorded up to it.
         """
-        duration = as_float("duration", duration, positive=True)
-        dt = self._as_step(dt)
-        record_every = as_count("record_every", record_every)
-        n_steps = step_count(duration, dt)
-        self._sync()
-        t0, initial = self._state.time, self._state.copy()
-        recording = Trajectory.allocate_recording(self._state.body_count, n_steps // record_every)
-        controller_error = None
-        stage = self._compiled_stage()
-        if stage is not None:
-            steps_done, failing, controller_error = self._simulate_stage(stage, dt, n_steps, recording,
-                                                                         int(record_every))  # fmt: skip
-        elif self._controllers or self._sensors or not isinstance(self._wind, (Constant, type(None))):
-            steps_done, failing, controller_error = self._simulate_stepwise(dt, n_steps, recording, int(record_every))
-        else:
-            steps_done, failing = simulate_steps(
-                self._model,
-                self._state,
-                self._inputs,
-                self._params,
-                self._scratch,
-                dt,
-                n_steps,
-                recording,
-                int(record_every),
-                self._actuators_for_step(dt),
-            )
-        frames = steps_done // record_every
-        trajectory = Trajectory.from_recording(
-            self._model, initial, recording, frames, t0 + dt * record_every * np.arange(1, frames + 1), dt
-        )
-        if controller_error is not None or failing >= 0:
-            error = controller_error if controller_error is not None else self._simulation_error(failing)
-            error.trajectory = trajectory
-            raise error
-        return trajectory
-
-    def _compiled_stage(self):
-        """The compiled stage that runs every controller of the world in their place (``Controllers.compiled_stage``),
-        or None."""
-        if not self._controllers:
-            return None
-        self._sync()
-        self._actuation.for_bodies(self._model.body_com_local)  # the actuators' rows in the arrays
-        return self._controllers.compiled_stage(self)
-
-    def _simulate_stage(self, stage, dt: float, n_steps: int, recording, record_every: int):
-        """The steps with the compiled ``stage`` between them: ``(steps_done, failing_body, error)`` as
-        :meth:`_simulate_stepwise`. Free bodies (no sensors, a constant wind) take all the steps in one call; else
-        each step is a call, and the stage one more (instead of a Python controller each)."""
-        if self._model.has_constraints or self._sensors or not isinstance(self._wind, (Constant, type(None))):
-            result = self._simulate_stepwise(dt, n_steps, recording, record_every, stage=stage)
-        else:
-            acts = self._actuators_for_step(dt)
-            state = self._state
-            clock = self._clock.count(state.time, state.step_count, dt)
-            result = stage.fly_free(self._model, state, self._inputs, acts, self._scratch, recording, dt, n_steps,
-                                    int(self._params.resolve_integrator(False)), record_every, clock)  # fmt: skip
-            advance_clock(state, dt, result[0])
-            self._inputs.clear()  # as simulate_steps: used, or dropped with a failed first step
-        stage.finish()
-        return result
-
-    def _simulate_stepwise(self, dt: float, n_steps: int, recording, record_every: int, stage=None):
-        """Step by step from Python, the controllers (or the compiled ``stage``) before each step and the sensors
-        after it: ``(steps_done, failing_body, error)``."""
-        for step in range(n_steps):
-            try:
-                failing = self._controlled_step(dt, stage)
-            except SimulationError as error:
-                return step, -1, error
-            if self._state.body_count != recording.pos.shape[1]:
-                raise ValueError("a controller added bodies during simulate; add them before it, or between calls")
-            if failing >= 0:
-                return step, failing, None
-            if (step + 1) % record_every == 0:
-                frame = (step + 1) // record_every - 1
-                for name in ("pos", "quat", "linvel", "angmom"):
-                    np.copyto(getattr(recording, name)[frame], getattr(self._state, f"body_{name}"))
-        return n_steps, -1, None
-
-    def _simulation_error(self, row: int) -> SimulationError:
-        name = self._model.body_name[row]
-        label = repr(name) if name is not None else f"#{row}"
-        step = self._state.step_count
-        return SimulationError(
-            f"body {label} became non-finite (NaN or Inf) in step {step} (t = {self._state.time:.6g} s); "
-            "the world keeps its state from before that step (the loads applied for it are dropped)",
-            body=name if name is not None else row,
-            step=step,
-        )
+        return world_stepping.simulate(self, duration, dt, record_every)
 
     # --- diagnostics --------------------------------------------------------------------------------
 

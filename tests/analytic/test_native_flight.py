@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 import tumble
+from tumble import world_stepping
 from tumble.control import Circle, Hover, Lissajous, MinimumSnap, SE3Controller
 from tumble.vehicles import Quadrotor
 
@@ -65,11 +66,11 @@ def test_the_compiled_flight_is_the_stepwise_flight_at_every_step_size(dt):
 
 def test_the_compiled_flights_are_used_only_when_every_controller_is_one():
     world, quad, _ = flight(Hover((0.0, 0.0, 1.0)), {}, None, stepwise=False)
-    assert world._compiled_stage() is not None
+    assert world_stepping._compiled_stage(world) is not None
     world.add_static(tumble.Plane())  # contacts: a step per call, the flights compiled between them
-    assert world._compiled_stage() is not None
+    assert world_stepping._compiled_stage(world) is not None
     world, quad, _ = flight(Hover((0.0, 0.0, 1.0)), {}, None, stepwise=True)
-    assert world._compiled_stage() is None
+    assert world_stepping._compiled_stage(world) is None
 
 
 @pytest.mark.parametrize("dt", [0.01, 1 / 240])
@@ -101,7 +102,7 @@ def test_a_body_that_fails_mid_run_stops_the_compiled_flight_as_the_stepwise_one
         world, quad, _ = flight(Hover((0.0, 0.0, 1.0)), {}, None, stepwise=stepwise)
         rock = world.add_body(None, mass=1.0, inertia=np.eye(3), position=(5.0, 0.0, 1.0), name="rock")
         rock.constant_force = (2e307, 0.0, 0.0)
-        assert (world._compiled_stage() is None) == stepwise
+        assert (world_stepping._compiled_stage(world) is None) == stepwise
         with pytest.raises(tumble.SimulationError, match=r"body 'rock' became non-finite") as error:
             world.simulate(10.0, 0.5)
         assert error.value.step == world.step_count > 0 and np.isfinite(world.state.body_pos).all()

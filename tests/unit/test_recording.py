@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 import tumble
-from tumble import pipeline, recording, scenes
+from tumble import recording, runner, scenes
 from tumble.trajectory_io import FRAME_ARRAYS, STATIC_ARRAYS
 
 h5py = pytest.importorskip("h5py")
@@ -89,12 +89,12 @@ def test_npz_and_hdf5_round_trip_the_same_arrays_and_metadata(tmp_path):
 def test_a_failed_run_leaves_every_frame_before_the_failing_step(tmp_path, monkeypatch):
     """A step that goes non-finite mid-chunk: the frames of the chunks before it and of the good steps of its
     chunk are in the file, which is closed with status "failed"; the error carries the same frames."""
-    checked = pipeline._first_non_finite_body
+    checked = runner._first_non_finite_body
 
     def fail_at_step_23(state, *args):
         return 3 if state.step_count == 23 else checked(state, *args)  # step_count is that before the step
 
-    monkeypatch.setattr(pipeline, "_first_non_finite_body", fail_at_step_23)
+    monkeypatch.setattr(runner, "_first_non_finite_body", fail_at_step_23)
     path = tmp_path / "failed.h5"
     with pytest.raises(tumble.SimulationError, match="box2") as info:
         recording.record(_pile(), 1.0, DT, path, chunk_frames=10)

@@ -1,0 +1,184 @@
+"""How a world steps: ``World.step`` and ``World.simulate`` around the runner (``runner.py``). A room of
+:class:`~tumble.World`: these functions read and write the world's parts as its own methods would.
+
+Before each step the controllers that are due run (``controllers.py``), or the compiled stage that stands in for
+them; the actuators' arrays and the wind are taken for the step; the runner advances the arrays; the sensors sample.
+A world with none of these Python parts takes all the steps of ``simulate`` in one call of the runner.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ._validate import as_count, as_float, as_step, step_count
+from .errors import SimulationError
+from .runner import advance_clock, record_frame, simulate_steps
+from .trajectory import Trajectory
+from .wind import Constant
+
+__all__ = ["checked_step", "simulate", "step"]
+
+
+def step(world, dt: float) -> None:
+    """Advance one step of ``dt`` seconds. Applied forces act during this step only.
+
+    Raises:
+        ValueError: ``dt`` does not advance the time, or its contacts would need more than 65 536 substeps
+            (``solver.substeps_for(dt)``); nothing has moved.
+        SimulationError: the step produced a non-finite value; the world keeps its state from before, and the
+            loads applied for the step are dropped (so that the next step can succeed).
+    """
+    dt = checked_step(world, dt)
+    failing = _controlled_step(world, dt)
+    if failing >= 0:
+        raise _simulation_error(world, failing)
+
+
+def checked_step(world, dt) -> float:
+    """``dt`` checked as a step of ``world``: one that advances its time and, where the contact solver runs,
+    needs no more substeps than it allows (before any controller runs or state changes)."""
+    dt = as_step("dt", dt, world._state.time)
+    world._sync()
+    if world._model.has_constraints:
+        world._params.solver.substeps_for(dt)
+    return dt
+
+
+def _controlled_step(world, dt: float, stage=None) -> int:
+    """The controllers that are due (or the compiled ``stage`` in their place), one step, the sensors' samples:
+    the failing body's row, or -1.
+
+    Raises:
+        SimulationError: a controller raised (before the step: the world is as it was).
+    """
+    if stage is None:
+        world._controllers.run(world, _next_step_time(world, dt), dt)
+    else:
+        stage.command(world._model, world._state, world._actuation.arrays, _next_step_time(world, dt), dt)
+    world._sync()
+    world._sensors.before_step(world)
+    _, failing = simulate_steps(world._model, world._state, world._inputs, world._params, world._scratch, dt,
+                                acts=_actuators_for_step(world, dt))  # fmt: skip
+    if failing < 0:
+        world._sensors.sample(world, dt)
+    return failing
+
+
+def _next_step_time(world, dt: float) -> float:
+    """The next step's start time as controllers and wind see it: counted, not accumulated."""
+    return world._clock.start_of_next_step(world._state.time, world._state.step_count, dt)
+
+
+def _actuators_for_step(world, dt: float):
+    """The actuators' arrays and the wind for the next steps; their bodies are kept awake (thrust that holds a
+    body still must not let it sleep, or a change of wind or command would not reach it)."""
+    if world._wind is not None:
+        world._actuation.wind = world._wind.velocity(_next_step_time(world, dt), dt)
+    else:
+        world._actuation.wind = np.zeros(3)
+    acts = world._actuation.for_bodies(world._model.body_com_local)
+    driven = world._actuation.driven_bodies()
+    if driven.size:
+        world._state.body_sleep_time[driven] = 0.0
+        world._state.body_sleeping[driven] = False
+    return acts
+
+
+def simulate(world, duration: float, dt: float, record_every: int = 1) -> Trajectory:
+    """Take ``round(duration / dt)`` steps in one compiled loop, recording every ``record_every`` steps.
+
+    The trajectory starts with the current state. On a :class:`SimulationError` the world keeps its last
+    good state and the error's ``trajectory`` holds the frames recorded up to it.
+    """
+    duration = as_float("duration", duration, positive=True)
+    dt = checked_step(world, dt)
+    record_every = as_count("record_every", record_every)
+    n_steps = step_count(duration, dt)
+    world._sync()
+    t0, initial = world._state.time, world._state.copy()
+    recording = Trajectory.allocate_recording(world._state.body_count, n_steps // record_every)
+    controller_error = None
+    stage = _compiled_stage(world)
+    if stage is not None:
+        steps_done, failing, controller_error = _simulate_stage(world, stage, dt, n_steps, recording,
+                                                                     int(record_every))  # fmt: skip
+    elif world._controllers or world._sensors or not isinstance(world._wind, (Constant, type(None))):
+        steps_done, failing, controller_error = _simulate_stepwise(world, dt, n_steps, recording, int(record_every))
+    else:
+        steps_done, failing = simulate_steps(
+            world._model,
+            world._state,
+            world._inputs,
+            world._params,
+            world._scratch,
+            dt,
+            n_steps,
+            recording,
+            int(record_every),
+            _actuators_for_step(world, dt),
+        )
+    frames = steps_done // record_every
+    trajectory = Trajectory.from_recording(
+        world._model, initial, recording, frames, t0 + dt * record_every * np.arange(1, frames + 1), dt
+    )
+    if controller_error is not None or failing >= 0:
+        error = controller_error if controller_error is not None else _simulation_error(world, failing)
+        error.trajectory = trajectory
+        raise error
+    return trajectory
+
+
+def _compiled_stage(world):
+    """The compiled stage that runs every controller of ``world`` in their place (``Controllers.compiled_stage``),
+    or None."""
+    if not world._controllers:
+        return None
+    world._sync()
+    world._actuation.for_bodies(world._model.body_com_local)  # the actuators' rows in the arrays
+    return world._controllers.compiled_stage(world)
+
+
+def _simulate_stage(world, stage, dt: float, n_steps: int, recording, record_every: int):
+    """The steps with the compiled ``stage`` between them: ``(steps_done, failing_body, error)`` as
+    :func:`_simulate_stepwise`. Free bodies (no sensors, a constant wind) take all the steps in one call; else
+    each step is a call, and the stage one more (instead of a Python controller each)."""
+    if world._model.has_constraints or world._sensors or not isinstance(world._wind, (Constant, type(None))):
+        result = _simulate_stepwise(world, dt, n_steps, recording, record_every, stage=stage)
+    else:
+        acts = _actuators_for_step(world, dt)
+        state = world._state
+        clock = world._clock.count(state.time, state.step_count, dt)
+        result = stage.fly_free(world._model, state, world._inputs, acts, world._scratch, recording, dt, n_steps,
+                                int(world._params.resolve_integrator(False)), record_every, clock)  # fmt: skip
+        advance_clock(state, dt, result[0])
+        world._inputs.clear()  # as simulate_steps: used, or dropped with a failed first step
+    stage.finish()
+    return result
+
+
+def _simulate_stepwise(world, dt: float, n_steps: int, recording, record_every: int, stage=None):
+    """Step by step from Python, the controllers (or the compiled ``stage``) before each step and the sensors
+    after it: ``(steps_done, failing_body, error)``."""
+    for step in range(n_steps):
+        try:
+            failing = _controlled_step(world, dt, stage)
+        except SimulationError as error:
+            return step, -1, error
+        if world._state.body_count != recording.pos.shape[1]:
+            raise ValueError("a controller added bodies during simulate; add them before it, or between calls")
+        if failing >= 0:
+            return step, failing, None
+        record_frame(recording, record_every, step, world._state)
+    return n_steps, -1, None
+
+
+def _simulation_error(world, row: int) -> SimulationError:
+    name = world._model.body_name[row]
+    label = repr(name) if name is not None else f"#{row}"
+    step = world._state.step_count
+    return SimulationError(
+        f"body {label} became non-finite (NaN or Inf) in step {step} (t = {world._state.time:.6g} s); "
+        "the world keeps its state from before that step (the loads applied for it are dropped)",
+        body=name if name is not None else row,
+        step=step,
+    )
