@@ -24,6 +24,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import portable
+from ._validate import as_array, as_float
+from .handles import Joint
 from .math3d import quat_mul, quat_to_mat33
 
 __all__ = ["JointDrive", "JointDrives"]
@@ -132,6 +134,43 @@ class JointDrives:
                     island = state.body_island == state.body_island[body]
                     state.body_sleeping[island] = False
                 state.body_sleep_time[body] = 0.0
+
+
+def checked_drive(world, joint, gear, gain, bias, ctrl_range, ref, coordinate, axes) -> dict:
+    """``World.add_joint_actuator``'s arguments checked, as :meth:`JointDrives.add` takes them (``axes`` turned into
+    the joint's frame on its first body)."""
+    if not isinstance(joint, Joint) or joint._world is not world:
+        raise TypeError(f"joint must be a joint of this world, got {joint!r}")
+    gear, gain, ref = as_float("gear", gear), as_float("gain", gain), as_float("ref", ref)
+    bias = as_array("bias", bias, (3,), batch=False)
+    if ctrl_range is not None:
+        low, high = (float(v) for v in as_array("ctrl_range", ctrl_range, (2,), batch=False))
+        if not low <= high:
+            raise ValueError(f"ctrl_range must be (low, high) with low <= high, got {ctrl_range!r}")
+        ctrl_range = (low, high)
+    count = {"universal": 2, "ball": 3}.get(joint.kind, 1)
+    if isinstance(coordinate, bool) or not isinstance(coordinate, (int, np.integer)) or not 0 <= coordinate < count:
+        raise ValueError(f"coordinate must be an integer in 0 to {count - 1} for a {joint.kind} joint, got "
+                         f"{coordinate!r}")  # fmt: skip
+    if (axes is None) != (joint.kind != "ball"):
+        raise ValueError(f"axes must be given for a ball joint's actuator and only for it, got {axes!r} for a "
+                         f"{joint.kind} joint")  # fmt: skip
+    if axes is not None:
+        axes = as_array("axes", axes, (3, 3), batch=False)
+        if not np.allclose(portable.matmul(axes, axes.T), np.eye(3), rtol=0.0, atol=1e-6):
+            raise ValueError(f"axes must be three orthonormal rows, got {axes.tolist()}")
+        axes = portable.matmul(
+            axes, joint_frames(world, joint.index)[0]
+        )  # in the joint's frame on its (solver's) first body
+    return {
+        "gear": gear,
+        "gain": gain,
+        "bias": bias,
+        "ctrl_range": ctrl_range,
+        "ref": ref,
+        "coordinate": int(coordinate),
+        "axes": axes,
+    }
 
 
 def joint_frames(world, index: int) -> tuple[np.ndarray, np.ndarray]:

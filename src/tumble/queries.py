@@ -1,12 +1,17 @@
-"""What a world can be asked about its geometry: the contacts of the last step, and rays."""
+"""What a world can be asked about its geometry: the contacts of the last step, rays and overlaps (the work of
+``World.contacts``, ``World.query_ray`` and ``World.query_overlap``)."""
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["Contacts", "RayHit"]
+from ._validate import as_filter, as_float, as_quaternion, as_unit_vector3, as_vector3
+from .shapes import Plane, Shape, TriMesh
+
+__all__ = ["Contacts", "RayHit", "first_ray_hit", "overlapping_bodies"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -73,3 +78,55 @@ class RayHit:
     distance: float
     point: np.ndarray
     normal: np.ndarray
+
+
+def _check_query_shape(shape) -> Shape:
+    if not isinstance(shape, Shape):
+        raise TypeError(
+            f"shape must be a Sphere, Box, Capsule, Cylinder or ConvexHull, got {shape!r} ({type(shape).__name__})"
+        )
+    if isinstance(shape, (Plane, TriMesh)):
+        raise ValueError(
+            f"shape must be a Sphere, Box, Capsule, Cylinder or ConvexHull (a convex solid) to query overlaps, "
+            f"got {shape!r}"
+        )
+    return shape
+
+
+def first_ray_hit(model, state, bodies: list, origin, direction, max_distance, mask) -> RayHit | None:
+    """``World.query_ray``: the arguments checked, the ray cast by the step's geometry; ``bodies`` the handles."""
+    from .geometry.raycast import raycast_shapes  # its kernels load on the first query, not with tumble
+
+    origin = as_vector3("origin", origin)
+    direction = as_unit_vector3("direction", direction, tiny=0.0)
+    if not (isinstance(max_distance, float) and max_distance == math.inf):
+        max_distance = as_float("max_distance", max_distance, nonnegative=True)
+    mask = as_filter("mask", mask)
+    shape, distance, point, normal = raycast_shapes(
+        model.geometry, state.body_pos, state.body_quat, origin, direction, max_distance,
+        model.shape_group, np.uint32(mask),
+    )  # fmt: skip
+    if shape < 0:
+        return None
+    if not (math.isfinite(distance) and np.isfinite(point).all()):
+        raise ValueError(
+            f"the ray from origin={origin.tolist()} along direction={direction.tolist()} meets a shape outside "
+            "float range"
+        )
+    body = bodies[int(model.shape_body[shape])]
+    return RayHit(body, int(shape), float(distance), np.array(point), np.array(normal))
+
+
+def overlapping_bodies(model, state, bodies: list, shape, position, orientation, mask) -> list:
+    """``World.query_overlap``: the arguments checked, the overlaps found by the step's contact kernels."""
+    from .geometry.overlap import overlapping_shapes
+
+    shape = _check_query_shape(shape)
+    position = as_vector3("position", position)
+    quat = as_quaternion("orientation", orientation)
+    mask = as_filter("mask", mask)
+    rows = overlapping_shapes(
+        model.geometry, state.body_pos, state.body_quat, model.shape_group, mask, shape, position, quat
+    )
+    indices = np.unique(model.shape_body[rows])
+    return [bodies[int(i)] for i in indices]

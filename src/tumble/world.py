@@ -10,11 +10,10 @@ reallocates them), without packing the model.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
 
 import numpy as np
 
-from . import diagnostics, portable, world_stepping
+from . import diagnostics, world_stepping
 from ._validate import (
     MAX_COUNT,
     as_array,
@@ -23,156 +22,37 @@ from ._validate import (
     as_material,
     as_quaternion,
     as_rate,
-    as_unit_vector3,
     as_vector3,
     finite_result,
-    mass_or_density,
 )
 from .actuators import Actuation, Actuator
-from .builder import ModelBuilder, ShapeSpec
+from .builder import ModelBuilder
 from .controllers import Controller, Controllers, StepClock
 from .handles import Body, Joint
 from .inputs import Inputs
 from .mass import MassProperties, require_invertible
 from .model import Model
-from .params import DEFAULT_SOLVER, INTEGRATOR_NAMES, Params, SolverSettings
-from .queries import Contacts, RayHit
+from .params import DEFAULT_SOLVER, Params, SolverSettings
+from .queries import Contacts, RayHit, first_ray_hit, overlapping_bodies
 from .rotation import quat_rotate
 from .scratch import Scratch
 from .sensors import Sensor, Sensors
-from .shapes import Plane, Shape, TriMesh
 from .state import State
 from .trajectory import Trajectory
 from .wind import Wind, as_wind
+from .world_building import (
+    NO_ROTATION,
+    ORIGIN,
+    body_mass_properties,
+    check_dynamic_shapes,
+    check_integrator,
+    explicit_mass_properties,
+    shape_items,
+    vector_or_origin,
+    world_apply,
+)
 
 __all__ = ["World"]
-
-_IDENTITY = np.array([1.0, 0.0, 0.0, 0.0])
-# add_body's defaults: an argument left at one of them skips its validation (bodies are added by the 100 000).
-_ORIGIN, _NO_ROTATION = (0.0, 0.0, 0.0), (1.0, 0.0, 0.0, 0.0)
-
-
-def _vector_or_origin(name: str, value) -> np.ndarray:
-    return np.zeros(3) if value is _ORIGIN else as_vector3(name, value)
-
-
-def _world_apply(tensor: np.ndarray, quat: np.ndarray, vector: np.ndarray) -> np.ndarray:
-    """``R T Rᵀ v`` for one body, inf where it overflows (the caller refuses it by the argument's name)."""
-    with np.errstate(over="ignore", invalid="ignore"):
-        try:
-            return diagnostics.world_tensor_apply(tensor[None], quat[None], vector[None])[0]
-        except ValueError:  # quat_rotate refused the overflowed T Rᵀv
-            return np.full(3, np.inf)
-
-
-def _check_integrator(integrator) -> str:
-    names = ("auto", *INTEGRATOR_NAMES)
-    if not isinstance(integrator, str) or integrator not in names:
-        raise ValueError(f"integrator must be one of {names}, got {integrator!r}")
-    return integrator
-
-
-def _check_dynamic_shapes(shape) -> None:
-    """Refuse planes and meshes in a dynamic body: a plane has no mass, and the contact kernels collide meshes as
-    fixed geometry only (convex shapes against a mesh, never a mesh against a mesh or a plane)."""
-    if shape is None:
-        return
-    items = (
-        [("shape", shape)] if isinstance(shape, Shape) else [(f"shape[{k}]", item[0]) for k, item in enumerate(shape)]
-    )
-    for label, item in items:
-        if isinstance(item, (Plane, TriMesh)):
-            kind = type(item).__name__
-            raise ValueError(
-                f"{label} cannot be a {kind} in a dynamic body: a {kind} can only be static (use world.add_static, "
-                f"or a ConvexHull for a dynamic body), got {item!r}"
-            )
-
-
-def _check_query_shape(shape) -> Shape:
-    if not isinstance(shape, Shape):
-        raise TypeError(
-            f"shape must be a Sphere, Box, Capsule, Cylinder or ConvexHull, got {shape!r} ({type(shape).__name__})"
-        )
-    if isinstance(shape, (Plane, TriMesh)):
-        raise ValueError(
-            f"shape must be a Sphere, Box, Capsule, Cylinder or ConvexHull (a convex solid) to query overlaps, "
-            f"got {shape!r}"
-        )
-    return shape
-
-
-def _shape_items(shape, material: tuple[float, float, float], group: int = 1, mask: int = 0xFFFFFFFF
-                 ) -> list[ShapeSpec]:  # fmt: skip
-    """``None``, one shape, or a list of ``(shape, position[, orientation])`` in the body frame; ``material`` is
-    ``(friction, restitution, rolling_resistance)``."""
-    if shape is None:
-        return []
-    if isinstance(shape, Shape):
-        return [ShapeSpec(shape, np.zeros(3), _IDENTITY.copy(), *material, group=group, mask=mask)]
-    if not isinstance(shape, Sequence) or isinstance(shape, str) or len(shape) == 0:
-        raise TypeError(
-            f"shape must be a Shape, a non-empty list of (shape, position[, orientation]) or None, got {shape!r}"
-        )
-    items = []
-    for k, item in enumerate(shape):
-        if not isinstance(item, Sequence) or len(item) not in (2, 3) or not isinstance(item[0], Shape):
-            raise TypeError(f"shape[{k}] must be (shape, position[, orientation]), got {item!r}")
-        position = as_vector3(f"shape[{k}] position", item[1])
-        quat = as_quaternion(f"shape[{k}] orientation", item[2]) if len(item) == 3 else _IDENTITY.copy()
-        items.append(ShapeSpec(item[0], position, quat, *material, group=group, mask=mask))
-    return items
-
-
-def _body_mass_properties(items: list[ShapeSpec], mass, density, inertia) -> MassProperties:
-    """Mass properties in the body frame: from the shapes (``mass=`` spread by volume) or explicit."""
-    if not items:
-        if density is not None:
-            raise ValueError(f"density={density!r} needs a shape; a body without geometry takes mass= and inertia=")
-        if mass is None or inertia is None:
-            raise ValueError(
-                "a body without geometry (shape=None) needs both mass= and inertia=, "
-                f"got mass={mass!r}, inertia={inertia!r}"
-            )
-        return MassProperties(as_float("mass", mass, positive=True), np.zeros(3), inertia)
-    kind, value = mass_or_density(mass, density)
-    per_volume = value if kind == "density" else 1.0
-    mp = _placed_mass_properties(items[0], per_volume)
-    for item in items[1:]:
-        mp = mp + _placed_mass_properties(item, per_volume)
-    if kind == "mass":
-        mp = mp.scaled_to(value)
-    if inertia is not None:
-        mp = MassProperties(mp.mass, mp.com, inertia)
-    return mp
-
-
-def _placed_mass_properties(item: ShapeSpec, density: float) -> MassProperties:
-    """One shape's mass properties in the body frame (as given when the shape frame is the body frame: most
-    bodies, and moving them would only cost time)."""
-    shape = item.shape
-    mp = shape._unit_mass_properties() if density == 1.0 else shape.mass_properties(density=density)
-    if (item.quat == _IDENTITY).all() and not item.position.any():
-        return mp
-    return mp.transformed(rotation=item.quat, translation=item.position)
-
-
-def _explicit_mass_properties(mass_properties, mass, density, inertia) -> MassProperties | None:
-    if mass_properties is None:
-        return None
-    if not isinstance(mass_properties, MassProperties):
-        raise TypeError(
-            f"mass_properties must be a tumble.MassProperties, got {mass_properties!r} "
-            f"({type(mass_properties).__name__})"
-        )
-    if mass is not None or density is not None or inertia is not None:
-        raise ValueError(
-            f"mass_properties= replaces mass=, density= and inertia=; got mass={mass!r}, density={density!r}, "
-            f"inertia={'given' if inertia is not None else None}"
-        )
-    if not mass_properties.mass > 0.0:
-        raise ValueError(f"mass_properties must have a positive mass for a dynamic body, got {mass_properties.mass!r}")
-    return mass_properties
 
 
 class World:
@@ -202,7 +82,7 @@ class World:
         joint_damping_ratio: float = DEFAULT_SOLVER.joint_damping_ratio,
     ):
         self._gravity = as_vector3("gravity", gravity)
-        self._params = Params(integrator=_check_integrator(integrator))
+        self._params = Params(integrator=check_integrator(integrator))
         self.set_solver(
             substeps=substeps,
             contact_hertz=contact_hertz,
@@ -252,10 +132,10 @@ class World:
         mass=None,
         density=None,
         inertia=None,
-        position=_ORIGIN,
-        orientation=_NO_ROTATION,
-        velocity=_ORIGIN,
-        angular_velocity=_ORIGIN,
+        position=ORIGIN,
+        orientation=NO_ROTATION,
+        velocity=ORIGIN,
+        angular_velocity=ORIGIN,
         friction: float = 0.5,
         restitution: float = 0.0,
         rolling_resistance: float = 0.0,
@@ -277,20 +157,20 @@ class World:
         of the body's shapes; see ``docs/contact.md``. ``mass_properties`` (a :class:`~tumble.MassProperties` in
         the body frame) gives mass, centre of mass and inertia at once, in place of ``mass``/``density``/``inertia``.
         """
-        position = _vector_or_origin("position", position)
-        quat = _IDENTITY.copy() if orientation is _NO_ROTATION else as_quaternion("orientation", orientation)
-        velocity = _vector_or_origin("velocity", velocity)
-        angular_velocity = np.zeros(3) if angular_velocity is _ORIGIN else as_rate("angular_velocity", angular_velocity)
+        position = vector_or_origin("position", position)
+        quat = np.array(NO_ROTATION) if orientation is NO_ROTATION else as_quaternion("orientation", orientation)
+        velocity = vector_or_origin("velocity", velocity)
+        angular_velocity = np.zeros(3) if angular_velocity is ORIGIN else as_rate("angular_velocity", angular_velocity)
         material = as_material(friction, restitution, rolling_resistance)
         linear_damping = as_float("linear_damping", linear_damping, nonnegative=True)
         angular_damping = as_float("angular_damping", angular_damping, nonnegative=True)
         name = self._check_name(name)
         group, mask = as_filter("collision_group", collision_group), as_filter("collision_mask", collision_mask)
-        items = _shape_items(shape, material, group, mask)
-        _check_dynamic_shapes(shape)
-        mp = _explicit_mass_properties(mass_properties, mass, density, inertia)
+        items = shape_items(shape, material, group, mask)
+        check_dynamic_shapes(shape)
+        mp = explicit_mass_properties(mass_properties, mass, density, inertia)
         if mp is None:
-            mp = _body_mass_properties(items, mass, density, inertia)
+            mp = body_mass_properties(items, mass, density, inertia)
         require_invertible(mp)
         # Skipping the rotations of zero vectors (the usual COM at the origin, a body at rest) keeps building cheap.
         com, angmom = position, np.zeros(3)
@@ -299,7 +179,7 @@ class World:
                 com = finite_result(position + quat_rotate(quat, mp.com), "position", position,
                                     "puts the centre of mass at")  # fmt: skip
         if angular_velocity.any():
-            angmom = _world_apply(mp.inertia, quat, angular_velocity)
+            angmom = world_apply(mp.inertia, quat, angular_velocity)
             finite_result(angmom, "angular_velocity", angular_velocity, "gives the angular momentum")
         index = self._builder.add_body(
             mp, items, linear_damping=linear_damping, angular_damping=angular_damping, name=name
@@ -327,7 +207,7 @@ class World:
         material = as_material(friction, restitution, rolling_resistance)
         name = self._check_name(name)
         group, mask = as_filter("collision_group", collision_group), as_filter("collision_mask", collision_mask)
-        items = _shape_items(shape, material, group, mask)
+        items = shape_items(shape, material, group, mask)
         index = self._builder.add_body(None, items, name=name)
         return self._append(index, position, quat, np.zeros(3), np.zeros(3))
 
@@ -392,35 +272,12 @@ class World:
         axis, then the other's. A ball joint's are three angles about ``axes`` ((3, 3), orthonormal rows, world
         frame now), turned in order as MuJoCo turns a body's three hinges: the first axis carried by the reference
         side (``a``, or the world when ``b`` is None), the last by the other; all zero at the joint's creation."""
-        from .joint_drives import JointDrives, joint_frames
+        from .joint_drives import JointDrives, checked_drive
 
-        if not isinstance(joint, Joint) or joint._world is not self:
-            raise TypeError(f"joint must be a joint of this world, got {joint!r}")
-        gear, gain, ref = as_float("gear", gear), as_float("gain", gain), as_float("ref", ref)
-        bias = as_array("bias", bias, (3,), batch=False)
-        if ctrl_range is not None:
-            low, high = (float(v) for v in as_array("ctrl_range", ctrl_range, (2,), batch=False))
-            if not low <= high:
-                raise ValueError(f"ctrl_range must be (low, high) with low <= high, got {ctrl_range!r}")
-            ctrl_range = (low, high)
-        count = {"universal": 2, "ball": 3}.get(joint.kind, 1)
-        if isinstance(coordinate, bool) or not isinstance(coordinate, (int, np.integer)) or not 0 <= coordinate < count:
-            raise ValueError(f"coordinate must be an integer in 0 to {count - 1} for a {joint.kind} joint, got "
-                             f"{coordinate!r}")  # fmt: skip
-        if (axes is None) != (joint.kind != "ball"):
-            raise ValueError(f"axes must be given for a ball joint's actuator and only for it, got {axes!r} for a "
-                             f"{joint.kind} joint")  # fmt: skip
-        if axes is not None:
-            axes = as_array("axes", axes, (3, 3), batch=False)
-            if not np.allclose(portable.matmul(axes, axes.T), np.eye(3), rtol=0.0, atol=1e-6):
-                raise ValueError(f"axes must be three orthonormal rows, got {axes.tolist()}")
-            axes = portable.matmul(
-                axes, joint_frames(self, joint.index)[0]
-            )  # in the joint's frame on its (solver's) first body
+        settings = checked_drive(self, joint, gear, gain, bias, ctrl_range, ref, coordinate, axes)
         if self._joint_drives is None:
             self._joint_drives = JointDrives()
-        return self._joint_drives.add(self, joint, gear=gear, gain=gain, bias=bias, ctrl_range=ctrl_range, ref=ref,
-                                      name=name, coordinate=int(coordinate), axes=axes)  # fmt: skip
+        return self._joint_drives.add(self, joint, name=name, **settings)
 
     @property
     def ctrl(self) -> np.ndarray:
@@ -648,7 +505,7 @@ class World:
 
     @integrator.setter
     def integrator(self, value: str) -> None:
-        self._params.integrator = _check_integrator(value)
+        self._params.integrator = check_integrator(value)
 
     @property
     def time(self) -> float:
@@ -724,27 +581,7 @@ class World:
         ``direction`` need not be unit; only shapes whose ``collision_group`` shares a bit with ``mask`` count.
         A ray that starts inside a solid shape hits it at distance 0.
         """
-        from .geometry.raycast import raycast_shapes
-
-        origin = as_vector3("origin", origin)
-        direction = as_unit_vector3("direction", direction, tiny=0.0)
-        if not (isinstance(max_distance, float) and max_distance == math.inf):
-            max_distance = as_float("max_distance", max_distance, nonnegative=True)
-        mask = as_filter("mask", mask)
-        model, state = self.model, self._state
-        shape, distance, point, normal = raycast_shapes(
-            model.geometry, state.body_pos, state.body_quat, origin, direction, max_distance,
-            model.shape_group, np.uint32(mask),
-        )  # fmt: skip
-        if shape < 0:
-            return None
-        if not (math.isfinite(distance) and np.isfinite(point).all()):
-            raise ValueError(
-                f"the ray from origin={origin.tolist()} along direction={direction.tolist()} meets a shape outside "
-                "float range"
-            )
-        body = self._bodies[int(model.shape_body[shape])]
-        return RayHit(body, int(shape), float(distance), np.array(point), np.array(normal))
+        return first_ray_hit(self.model, self._state, self._bodies, origin, direction, max_distance, mask)
 
     def query_overlap(
         self, shape, position=(0.0, 0.0, 0.0), orientation=(1.0, 0.0, 0.0, 0.0), *, mask: int = 0xFFFFFFFF
@@ -761,18 +598,7 @@ class World:
         Returns:
             The bodies, sorted by :attr:`Body.index`, each once (empty when nothing overlaps).
         """
-        from .geometry.overlap import overlapping_shapes
-
-        shape = _check_query_shape(shape)
-        position = as_vector3("position", position)
-        quat = as_quaternion("orientation", orientation)
-        mask = as_filter("mask", mask)
-        model, state = self.model, self._state
-        rows = overlapping_shapes(
-            model.geometry, state.body_pos, state.body_quat, model.shape_group, mask, shape, position, quat
-        )
-        indices = np.unique(model.shape_body[rows])
-        return [self._bodies[int(i)] for i in indices]
+        return overlapping_bodies(self.model, self._state, self._bodies, shape, position, orientation, mask)
 
     # --- checkpoints --------------------------------------------------------------------------------
 
