@@ -343,15 +343,15 @@ class World:
     def to_scene(self, *, dt: float | None = None, duration: float | None = None) -> dict:
         """This world now as a scene dict, the structure of a scene file (``tumble.scene_file.dumps`` writes it as
         TOML or JSON; ``tumble.scene_file.from_dict`` builds it again)."""
-        from .scene_file import to_scene
+        from .io.scene_dump import world_to_scene as to_scene
 
         return to_scene(self, dt=dt, duration=duration)
 
     def to_mjcf(self, *, timestep: float | None = None) -> str:
         """This world now as MJCF text, to be cross-checked in MuJoCo: joints as MuJoCo's body tree, loops as
         equality constraints, exact mass properties, the present velocities as the keyframe ``now``; what MJCF
-        cannot say is refused with a ``ValueError`` naming it (``tumble/models/mjcf/export.py``)."""
-        from .models.mjcf.export import world_to_mjcf
+        cannot say is refused with a ``ValueError`` naming it (``tumble/io/mjcf_export.py``)."""
+        from .io.mjcf_export import world_to_mjcf
 
         if timestep is not None:
             timestep = as_float("timestep", timestep, positive=True)

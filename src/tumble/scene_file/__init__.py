@@ -26,9 +26,9 @@ from pathlib import Path
 
 from pydantic import ValidationError
 
+from ..io.scene_dump import world_to_scene
 from . import schema
 from .build import SceneError, build_world
-from .dump import world_to_scene
 from .overrides import apply as apply_overrides
 
 __all__ = [

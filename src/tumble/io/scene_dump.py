@@ -12,12 +12,21 @@ import math
 
 import numpy as np
 
+from .. import wind as winds
+from ..control import CascadedPID, Circle, Hover, Lissajous, MinimumSnap, SE3Controller
 from ..rotation import quat_multiply, quat_rotate
 from ..shapes import Box, Capsule, ConvexHull, Cylinder, Plane, Sphere, TriMesh
-from ..vehicles import quadrotors
-from .vehicles import vehicle_to_scene, wind_to_scene
+from ..vehicles import Quadrotor, quadrotors
 
-__all__ = ["body_names", "joint_entry", "world_to_scene"]
+__all__ = [
+    "CONTROLLERS",
+    "REFERENCES",
+    "body_names",
+    "joint_entry",
+    "vehicle_to_scene",
+    "wind_to_scene",
+    "world_to_scene",
+]
 
 
 def _floats(values) -> list:
@@ -180,3 +189,68 @@ def world_to_scene(world, *, dt: float | None = None, duration: float | None = N
     if wind is not None:
         scene["wind"] = wind
     return scene
+
+
+# The controllers and trajectories a scene file names (tumble.scene_file builds them by these names).
+CONTROLLERS = {"se3": SE3Controller, "cascaded_pid": CascadedPID}
+REFERENCES = {"hover": Hover, "circle": Circle, "lissajous": Lissajous, "minimum_snap": MinimumSnap}
+
+
+def _spec_of(obj, kinds: dict, fields: tuple[str, ...]) -> dict | None:
+    """``{"type": name, field: value, ...}`` for an instance of one of ``kinds``; None for anything else."""
+    for name, kind in kinds.items():
+        if type(obj) is kind:
+            out = {"type": name}
+            for field in fields:
+                value = getattr(obj, field, None)
+                if value is not None:
+                    out[field] = value.tolist() if isinstance(value, np.ndarray) else value
+            return out
+    return None
+
+
+_CONTROLLER_FIELDS = ("kp_pos", "kd_pos", "ki_pos", "kp_att", "kd_att", "feedforward", "kp_vel", "ki_vel", "kp_rate",
+                      "integral_limit")  # fmt: skip
+_REFERENCE_FIELDS = ("position", "center", "radius", "frequency", "A", "B", "a", "b", "delta", "waypoints", "times",
+                     "yaw")  # fmt: skip
+
+
+def vehicle_to_scene(quad: Quadrotor, name: str) -> dict:
+    """The ``[[vehicles]]`` entry of ``quad`` now. A controller or trajectory that is not one of
+    ``tumble.control``'s is left out (the vehicle is then written with its motors' present commands)."""
+    body = quad.body
+    params = {name: (_floats(value) if isinstance(value, np.ndarray) else value)
+              for name, value in quad.params.items()}  # fmt: skip
+    params["rotor_directions"] = [int(d) for d in quad.params["rotor_directions"]]
+    entry = {"type": "quadrotor", "params": params, "layout": quad.layout, "position": _floats(body.position),
+             "orientation": _floats(body.orientation), "velocity": _floats(body.velocity),
+             "angular_velocity": _floats(body.angular_velocity), "rotor_speeds": _floats(quad.rotor_speeds),
+             "name": name}  # fmt: skip
+    flight = quad._flight
+    controller = trajectory = None
+    if flight is not None and flight.handle in quad.world.controllers:
+        controller = _spec_of(flight.controller, CONTROLLERS, _CONTROLLER_FIELDS)
+        trajectory = _spec_of(flight.trajectory, REFERENCES, _REFERENCE_FIELDS)
+    if controller is not None and trajectory is not None:
+        if flight.rate is not None:
+            controller["rate"] = flight.rate
+        entry.update(controller=controller, trajectory=trajectory)
+    else:
+        entry["commands"] = _floats(quad.commanded_rotor_speeds)
+    return entry
+
+
+def wind_to_scene(wind) -> dict | None:
+    """The ``[wind]`` table of a world's wind (None for still air or a wind model of the user's own)."""
+    if isinstance(wind, winds.Constant):
+        return {"type": "constant", "velocity": _floats(wind.v)}
+    if isinstance(wind, winds.Sinusoid):
+        return {"type": "sinusoid", "mean": _floats(wind.mean), "amplitude": _floats(wind.amplitude),
+                "frequency": wind.frequency}  # fmt: skip
+    if isinstance(wind, winds.Dryden):
+        out = {"type": "dryden", "mean": _floats(wind.mean), "sigma": _floats(wind.sigma),
+               "length_scale": _floats(wind.length_scale)}  # fmt: skip
+        if wind.seed is not None:
+            out["seed"] = wind.seed
+        return out
+    return None

@@ -25,11 +25,11 @@ from xml.sax.saxutils import quoteattr
 
 import numpy as np
 
-from ...rotation import quat_conjugate, quat_multiply, quat_rotate, quat_to_matrix
-from ...scene_file.dump import body_names, joint_entry
-from ...shapes import Box, Capsule, ConvexHull, Cylinder, Plane, Sphere
-from ...vehicles import quadrotors
-from .frames import quat_z_to
+from ..models.mjcf.frames import quat_z_to
+from ..rotation import quat_conjugate, quat_multiply, quat_rotate, quat_to_matrix
+from ..shapes import Box, Capsule, ConvexHull, Cylinder, Plane, Sphere
+from ..vehicles import quadrotors
+from .scene_dump import body_names, joint_entry
 
 __all__ = ["world_to_mjcf"]
 
