@@ -193,6 +193,11 @@ def save_world(world, path: str | os.PathLike) -> Path:
     """
     from ._version import __version__
 
+    drives = world.ctrl.shape[0]
+    if drives:
+        raise ValueError(
+            f"save: the world has {drives} joint actuators (world.ctrl), which checkpoints do not hold (yet)"
+        )
     path = Path(path)
     if path.suffix.lower() in (".h5", ".hdf5", ".he5"):
         raise ValueError(f"checkpoints are .npz files, got {os.fspath(path)!r}")

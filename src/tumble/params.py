@@ -6,9 +6,12 @@ import math
 from dataclasses import dataclass, field
 from enum import IntEnum
 
+import numpy as np
+
+from ._validate import MAX_COUNT, as_float
 from .dynamics.contact_solver import SolverSettings
 
-__all__ = ["Integrator", "Params", "INTEGRATOR_NAMES", "DEFAULT_SOLVER", "SolverSettings"]
+__all__ = ["Integrator", "Params", "INTEGRATOR_NAMES", "DEFAULT_SOLVER", "SolverSettings", "solver_with"]
 
 
 class Integrator(IntEnum):
@@ -77,3 +80,28 @@ class Params:
         if self.integrator == "auto":
             return Integrator.SYMPLECTIC if has_constraints else Integrator.EXACT_OR_RK4
         return INTEGRATOR_NAMES[self.integrator]
+
+
+def solver_with(solver: SolverSettings, settings: dict) -> SolverSettings:
+    """``solver`` with ``settings`` (names and values, as ``World.set_solver`` takes them) checked and changed."""
+    current = solver._asdict()
+    for key, value in settings.items():
+        if key not in current:
+            raise TypeError(f"unknown solver setting {key!r}; settings: {sorted(current)}")
+        if key == "substeps":
+            if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)):
+                kind = type(value).__name__
+                raise TypeError(f"substeps must be an integer >= 1 (at most {MAX_COUNT}), got {value!r} ({kind})")
+            if not 1 <= value <= MAX_COUNT:
+                raise ValueError(f"substeps must be an integer >= 1 (at most {MAX_COUNT}), got {value!r}")
+            current[key] = int(value)
+        elif key == "sleep":
+            if not isinstance(value, (bool, np.bool_)):
+                raise TypeError(f"sleep must be True or False, got {value!r}")
+            current[key] = bool(value)
+        elif key == "joint_hertz" and value == math.inf:
+            current[key] = math.inf  # as stiff as the substeps allow (the default)
+        else:
+            positive = key in ("contact_hertz", "contact_push_max", "joint_hertz")
+            current[key] = as_float(key, value, positive=positive, nonnegative=not positive)
+    return SolverSettings(**current)

@@ -15,7 +15,6 @@ import numpy as np
 
 from . import diagnostics, world_stepping
 from ._validate import (
-    MAX_COUNT,
     as_array,
     as_filter,
     as_float,
@@ -32,7 +31,7 @@ from .handles import Body, Joint
 from .inputs import Inputs
 from .mass import MassProperties, require_invertible
 from .model import Model
-from .params import DEFAULT_SOLVER, Params, SolverSettings
+from .params import DEFAULT_SOLVER, Params, SolverSettings, solver_with
 from .queries import Contacts, RayHit, first_ray_hit, overlapping_bodies
 from .rotation import quat_rotate
 from .scratch import Scratch
@@ -46,6 +45,7 @@ from .world_building import (
     body_mass_properties,
     check_dynamic_shapes,
     check_integrator,
+    checked_name,
     explicit_mass_properties,
     shape_items,
     vector_or_origin,
@@ -164,7 +164,7 @@ class World:
         material = as_material(friction, restitution, rolling_resistance)
         linear_damping = as_float("linear_damping", linear_damping, nonnegative=True)
         angular_damping = as_float("angular_damping", angular_damping, nonnegative=True)
-        name = self._check_name(name)
+        name = checked_name(self._builder, name)
         group, mask = as_filter("collision_group", collision_group), as_filter("collision_mask", collision_mask)
         items = shape_items(shape, material, group, mask)
         check_dynamic_shapes(shape)
@@ -205,7 +205,7 @@ class World:
         position = as_vector3("position", position)
         quat = as_quaternion("orientation", orientation)
         material = as_material(friction, restitution, rolling_resistance)
-        name = self._check_name(name)
+        name = checked_name(self._builder, name)
         group, mask = as_filter("collision_group", collision_group), as_filter("collision_mask", collision_mask)
         items = shape_items(shape, material, group, mask)
         index = self._builder.add_body(None, items, name=name)
@@ -362,17 +362,6 @@ class World:
         """Every joint, in the order they were added."""
         return list(self._joints)
 
-    def _check_name(self, name) -> str | None:
-        if name is None:
-            return None
-        if not isinstance(name, str) or not name:
-            raise TypeError(f"name must be a non-empty string or None, got {name!r}")
-        if "\x00" in name:
-            raise ValueError(f"name must not hold a NUL character (HDF5 strings end there), got {name!r}")
-        if self._builder.index_of(name) is not None:
-            raise ValueError(f"name must be unique in the world, {name!r} is already taken")
-        return name
-
     def _append(self, index, com, quat, velocity, angmom) -> Body:
         """The new body's handle; its (3,) and (4,) float64 arrays must be fresh: the world owns them from now."""
         for column, value in zip(self._pending, (com, quat, velocity, angmom), strict=True):
@@ -477,27 +466,7 @@ class World:
         ``time_to_sleep`` [s] (all >= 0), ``joint_hertz`` (> 0; capped at a quarter of the substep rate, and the
         default ``inf`` means that cap: 120 Hz at 60 Hz with 8 substeps) and ``joint_damping_ratio`` (>= 0), the
         stiffness of the joints' position correction."""
-        current = self._params.solver._asdict()
-        for key, value in settings.items():
-            if key not in current:
-                raise TypeError(f"unknown solver setting {key!r}; settings: {sorted(current)}")
-            if key == "substeps":
-                if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)):
-                    kind = type(value).__name__
-                    raise TypeError(f"substeps must be an integer >= 1 (at most {MAX_COUNT}), got {value!r} ({kind})")
-                if not 1 <= value <= MAX_COUNT:
-                    raise ValueError(f"substeps must be an integer >= 1 (at most {MAX_COUNT}), got {value!r}")
-                current[key] = int(value)
-            elif key == "sleep":
-                if not isinstance(value, (bool, np.bool_)):
-                    raise TypeError(f"sleep must be True or False, got {value!r}")
-                current[key] = bool(value)
-            elif key == "joint_hertz" and value == math.inf:
-                current[key] = math.inf  # as stiff as the substeps allow (the default)
-            else:
-                positive = key in ("contact_hertz", "contact_push_max", "joint_hertz")
-                current[key] = as_float(key, value, positive=positive, nonnegative=not positive)
-        self._params.solver = SolverSettings(**current)
+        self._params.solver = solver_with(self._params.solver, settings)
 
     @property
     def integrator(self) -> str:
@@ -607,9 +576,6 @@ class World:
         bit; see ``docs/files.md``."""
         from .checkpoint import save_world
 
-        if self._joint_drives is not None:
-            raise ValueError(f"save: the world has {len(self._joint_drives.drives)} joint actuators (world.ctrl), "
-                             "which checkpoints do not hold (yet)")  # fmt: skip
         save_world(self, path)
 
     @classmethod

@@ -20,6 +20,7 @@ __all__ = [
     "body_mass_properties",
     "check_dynamic_shapes",
     "check_integrator",
+    "checked_name",
     "explicit_mass_properties",
     "shape_items",
     "vector_or_origin",
@@ -139,3 +140,16 @@ def explicit_mass_properties(mass_properties, mass, density, inertia) -> MassPro
     if not mass_properties.mass > 0.0:
         raise ValueError(f"mass_properties must have a positive mass for a dynamic body, got {mass_properties.mass!r}")
     return mass_properties
+
+
+def checked_name(builder, name) -> str | None:
+    """``name`` checked as a new body's: None, or a non-empty string without NUL that no body of ``builder`` has."""
+    if name is None:
+        return None
+    if not isinstance(name, str) or not name:
+        raise TypeError(f"name must be a non-empty string or None, got {name!r}")
+    if "\x00" in name:
+        raise ValueError(f"name must not hold a NUL character (HDF5 strings end there), got {name!r}")
+    if builder.index_of(name) is not None:
+        raise ValueError(f"name must be unique in the world, {name!r} is already taken")
+    return name

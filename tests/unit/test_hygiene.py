@@ -250,3 +250,9 @@ def test_every_kernel_is_called_from_python():
     paths = [*(SOURCE / "tumble").rglob("*.py"), *(REPO / "tests").rglob("*.py"), *(REPO / "benchmarks").rglob("*.py")]
     sources = {path.relative_to(REPO).as_posix(): path.read_text(encoding="utf-8") for path in paths}
     assert _kernels_python_never_names(sources) == []
+
+
+def test_world_is_a_facade_over_its_rooms():
+    """World delegates building, stepping, queries and I/O to the modules named for them (issue 45, part 3)."""
+    lines = (SOURCE / "tumble" / "world.py").read_text(encoding="utf-8").count("\n")
+    assert lines < 600, f"world.py has {lines} lines; move what it does into world_building, world_stepping, ..."
