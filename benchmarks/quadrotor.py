@@ -7,7 +7,7 @@ The flight: RotorPy's Crazyflie (``tumble.vehicles.CRAZYFLIE``), from rest at th
 gains) called at every step, for ``quadrotor_seconds`` of simulated time, at 100 Hz and at 500 Hz:
 
 - tumble: ``quad.fly(SE3Controller(quad), Lissajous(...))`` and ``world.simulate`` (its default integrator, RK4
-  over each step with the motors' exact lag); the flight runs inside the compiled loop (``tumble/flight/native.py``).
+  over each step with the motors' exact lag); the flight runs inside the compiled loop (``tumble/control/native.py``).
 - tumble with ``CascadedPID``: a controller in plain Python and NumPy, no compiled code of its own, as a user's
   callback would be.
 - tumble with no controller, the rotors at fixed speeds: the compiled loop alone, the engine's floor.

@@ -25,7 +25,7 @@ _PACKAGE_DIR = Path(__file__).resolve().parent
 
 # Subpackages whose kernels nothing outside them calls: an edit there invalidates their own kernels only.
 # Everything else (top-level modules, geometry/, dynamics/) is the core that every kernel may embed.
-_LEAF_PACKAGES = ("articulation", "flight", "lagrange")
+_LEAF_PACKAGES = ("articulation", "control", "lagrange")
 
 
 def _leaf_of(path: Path) -> str | None:

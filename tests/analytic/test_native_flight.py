@@ -1,4 +1,4 @@
-"""Flights inside the compiled loop (``tumble.flight.native``, a compiled stage of ``tumble.controllers``):
+"""Flights inside the compiled loop (``tumble.control.native``, a compiled stage of ``tumble.controllers``):
 ``world.simulate`` of free-flying vehicles flown by the SE(3) controller on a known reference takes all its steps
 in one kernel call, and flies exactly as the step-by-step path does."""
 

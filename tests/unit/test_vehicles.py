@@ -198,7 +198,7 @@ def test_minimum_snap_passes_every_waypoint_at_its_time_continuous_to_snap():
         pieces = traj._coefficients  # and exactly at the knot, from each polynomial
         k = times.index(t)
         for n in range(5):
-            from tumble.references import _basis
+            from tumble.control.trajectories import _basis
 
             left = _basis(n, 1.0) @ pieces[k - 1] / (times[k] - times[k - 1]) ** n
             right = _basis(n, 0.0) @ pieces[k] / (times[k + 1] - times[k]) ** n

@@ -1,5 +1,5 @@
 """The compiled parts of flight control: the SE(3) law from the state arrays, the desired attitude and its error,
-and the mixer's allocation under saturation (equations in ``tumble.flight`` and ``tumble.vehicles``).
+and the mixer's allocation under saturation (equations in ``tumble.control`` and ``tumble.vehicles``).
 
 One controller call is one kernel call: a controller at every step of a 500 Hz world costs microseconds, not the
 hundreds a NumPy version of the same 3-vector algebra takes.
@@ -105,7 +105,7 @@ def _mat(a):
 @kernel
 def se3_rotor_speeds(pos, vel, quat, angmom, inv_inertia, inertia, mass, gravity, reference, yaw, yaw_rate, kp, kd,
                      integral, kp_att, kd_att, feedforward, inverse, k_thrust, low, high, out):  # fmt: skip
-    """The SE(3) controller (``tumble.flight.SE3Controller``) for the body at ``pos``, ``vel`` (its COM, world),
+    """The SE(3) controller (``tumble.control.SE3Controller``) for the body at ``pos``, ``vel`` (its COM, world),
     ``quat`` and spin ``angmom`` (world), ``inv_inertia``/``inertia`` (3, 3) in its frame; ``reference`` (4, 3): the
     desired position, velocity, acceleration and jerk; ``integral``: the integral term's acceleration (3,). Rotor
     speeds into ``out`` (4,)."""

@@ -1,11 +1,8 @@
-"""Flight control of a :class:`~tumble.vehicles.Quadrotor`: the geometric SE(3) tracking controller, a cascaded
-PID, the inner loops of a flight stack (:class:`Autopilot`) and :func:`fly`. Reached as ``tumble.control.*``.
+"""The geometric SE(3) tracking controller of a :class:`~tumble.vehicles.Quadrotor`, and what the other flight
+controllers share with it (the desired attitude and its error, gains, the integral, a reference's vectors).
+Reached as ``tumble.control.*``.
 
-Notation (Lee, Leok & McClamroch, "Geometric tracking control of a quadrotor UAV on SE(3)", IEEE CDC 2010): the
-vehicle at ``x``, ``v`` with rotation ``R`` (body to world) and body rates ``Ω``, inertia ``J``, mass ``m``, gravity
-``g`` (the world's vector); the reference's position ``x_d``, velocity, acceleration, jerk and yaw ``ψ_d``. Every
-controller ends in a collective thrust ``f`` and body moments ``M``, turned into rotor speeds by the vehicle's
-mixer (``Mixer.allocate``, which keeps the thrust first under saturation).
+Notation: the package's (``tumble.control``).
 """
 
 from __future__ import annotations
@@ -15,16 +12,15 @@ import math
 import numpy as np
 
 from .. import portable
-from .._validate import as_array, as_float, as_quaternion, as_vector3
-from ..rotation import quat_to_matrix
+from .._validate import as_array, as_float
 from . import kernels
 
-__all__ = ["Autopilot", "CascadedPID", "SE3Controller", "bad_rotor_speeds"]
+__all__ = ["SE3Controller", "attitude_error", "bad_rotor_speeds", "desired_rotation"]
 
 
 def desired_rotation(force, yaw: float) -> np.ndarray:
     """The rotation whose ``z`` axis is along ``force`` and whose ``x`` axis is the heading ``yaw`` projected on the
-    plane normal to it (Lee et al. 2010, section IV; :func:`tumble.flight.kernels.desired_axes`)."""
+    plane normal to it (Lee et al. 2010, section IV; :func:`tumble.control.kernels.desired_axes`)."""
     return np.column_stack(kernels.desired_axes((float(force[0]), float(force[1]), float(force[2])), float(yaw)))
 
 
@@ -47,9 +43,9 @@ def _gains(name: str, value, size: int) -> np.ndarray:
 
 
 def _vehicle(quad):
-    from ..vehicles import Quadrotor
-
-    if not isinstance(quad, Quadrotor):
+    """``quad`` checked as a vehicle: its body, rotors, mixer, parameters and world (a Quadrotor's; by what it has,
+    as control sits below tumble.vehicles, which imports it)."""
+    if not all(hasattr(quad, part) for part in ("body", "rotors", "mixer", "params", "world")):
         raise TypeError(f"quad must be a tumble.vehicles.Quadrotor, got {quad!r}")
     return quad
 
@@ -181,139 +177,6 @@ class SE3Controller:
                                  self.feedforward, mixer.inverse, params["k_thrust"], *mixer.squared_limits,
                                  speeds)  # fmt: skip
         return speeds
-
-
-class Autopilot:
-    """The inner loops of a flight stack for one quadrotor: the command levels below trajectory tracking, each
-    held by loops that run before every step of the world until the next command (``quad.autopilot``).
-
-    - ``thrust_moments(thrust, moments)``: collective thrust [N] and body moments [N m], through the mixer;
-    - ``thrust_rates(thrust, rates)``: body rates [rad/s] held by ``M = J k_rate (Ω_c − Ω) + Ω × J Ω``;
-    - ``thrust_attitude(thrust, orientation)``: an attitude held by the rate loop on ``Ω_c = −k_att e_R``;
-    - ``velocity(velocity, yaw=0)``: a world velocity [m/s] held by ``a = k_vel (v_c − v)``, the thrust and attitude
-      that give it (as the SE(3) controller), and the loops above.
-
-    ``quad.command_rotor_speeds`` ends the held command. Gains: ``kp_rate`` [1/s], ``kp_att`` [1/s], ``kp_vel``
-    [1/s], attributes that may be changed; by default the rate and attitude loops together are the vehicle's
-    attitude PD (``k_rate = kd_att``, ``k_att = kp_att / kd_att``, from ``quad.params``).
-    """
-
-    def __init__(self, quad, kp_rate=None, kp_att=None, kp_vel=(4.0, 4.0, 9.0)):
-        self.quad = _vehicle(quad)
-        pd_kp, pd_kd = _attitude_gains(self.quad, None, None)
-        self.kp_rate = pd_kd if kp_rate is None else as_float("kp_rate", kp_rate, nonnegative=True)
-        self.kp_att = pd_kp / pd_kd if kp_att is None else as_float("kp_att", kp_att, nonnegative=True)
-        self.kp_vel = _gains("kp_vel", kp_vel, 3)
-        self._hold = None  # the held command: a function of no argument that commands the rotors
-        self._controller = None
-
-    # The loops, innermost first; each returns rotor speeds (4,).
-    def _rates_to_speeds(self, thrust: float, rates_commanded: np.ndarray) -> np.ndarray:
-        inertia = self.quad.params["inertia"]
-        rates = self.quad.body.angular_velocity_body
-        moments = portable.matvec(inertia, self.kp_rate * (rates_commanded - rates)) + np.cross(
-            rates, portable.matvec(inertia, rates)
-        )
-        return self.quad.mixer.allocate(thrust, moments)
-
-    def _attitude_to_speeds(self, thrust: float, desired: np.ndarray, rates_feedforward=(0.0, 0.0, 0.0)):
-        rotation = self.quad.body.rotation
-        rates = -self.kp_att * attitude_error(rotation, desired) + portable.matvec(
-            portable.matmul(rotation.T, desired), np.asarray(rates_feedforward, np.float64)
-        )
-        return self._rates_to_speeds(thrust, rates)
-
-    def _acceleration_to_speeds(self, acceleration: np.ndarray, yaw: float, yaw_rate: float = 0.0):
-        """The thrust along the body's z and the attitude that give the world ``acceleration`` against gravity."""
-        force = self.quad.params["mass"] * (acceleration - self.quad.world.gravity)
-        rotation = self.quad.body.rotation
-        desired = desired_rotation(force, yaw)
-        return self._attitude_to_speeds(float(portable.dot(force, rotation[:, 2])), desired, (0.0, 0.0, yaw_rate))
-
-    # The command levels.
-    def thrust_moments(self, thrust, moments) -> None:
-        """Command the collective thrust [N] and body moments (3,) [N m] (no loop: held as rotor speeds)."""
-        speeds = self.quad.mixer.allocate(thrust, moments)
-        self.quad.command_rotor_speeds(speeds)
-
-    def thrust_rates(self, thrust, rates) -> None:
-        """Command the collective thrust [N] and the body rates (3,) [rad/s], held by the rate loop."""
-        thrust, rates = as_float("thrust", thrust), as_vector3("rates", rates)
-        self._start(lambda: self._rates_to_speeds(thrust, rates))
-
-    def thrust_attitude(self, thrust, orientation) -> None:
-        """Command the collective thrust [N] and the attitude (a quaternion w, x, y, z), held by the attitude loop."""
-        thrust = as_float("thrust", thrust)
-        desired = quat_to_matrix(as_quaternion("orientation", orientation))
-        self._start(lambda: self._attitude_to_speeds(thrust, desired))
-
-    def velocity(self, velocity, yaw=0.0) -> None:
-        """Command the world velocity (3,) [m/s] and the heading ``yaw`` [rad], held by the velocity loop."""
-        velocity, yaw = as_vector3("velocity", velocity), as_float("yaw", yaw)
-        self._start(lambda: self._acceleration_to_speeds(self.kp_vel * (velocity - self.quad.body.velocity), yaw))
-
-    def _start(self, hold) -> None:
-        self._hold = hold
-        self.quad._command(hold())
-        if self._controller is None:
-            self._controller = self.quad.world.add_controller(self._run, name=f"autopilot of {self.quad!r}")
-
-    def _run(self, world, t) -> None:
-        self.quad._command(self._hold())
-
-    @property
-    def active(self) -> bool:
-        """Whether a command is being held by the loops."""
-        return self._controller is not None
-
-    def stop(self) -> None:
-        """Stop holding the command (the rotors keep their last commanded speeds)."""
-        if self._controller is not None:
-            self._controller.remove()
-            self._controller = self._hold = None
-
-
-class CascadedPID:
-    """A cascaded PID flight controller, as the flight stacks of small drones (PX4, the Crazyflie's): each loop
-    commands the next, faster one.
-
-        v_c = v_d + k_p,pos (x_d − x)                                   position → velocity [1/s]
-        a_c = a_d + k_p,vel (v_c − v) + k_i,vel ∫(v_c − v) dt           velocity → acceleration [1/s, 1/s²]
-        f, R_c from m (a_c − g) and ψ_d                                  (as :class:`SE3Controller`)
-        Ω_c = −k_att e_R + Rᵀ R_c (0, 0, ψ̇_d)                            attitude → body rates [1/s]
-        M   = J k_rate (Ω_c − Ω) + Ω × J Ω                              body rates → moments [1/s]
-
-    The defaults give the SE(3) controller's stiffness (``k_p,vel k_p,pos`` = (6.4, 6.4, 15.3) s⁻², ``k_p,vel`` =
-    (4, 4, 9) s⁻¹, and the attitude and rate loops of :class:`Autopilot`, the vehicle's attitude PD).
-    ``update(t, reference)`` returns rotor speeds (4,) [rad/s].
-    """
-
-    def __init__(self, quad, kp_pos=(1.6, 1.6, 1.7), kp_vel=(4.0, 4.0, 9.0), ki_vel=0.0, kp_att=None,
-                 kp_rate=None, integral_limit=3.0):  # fmt: skip
-        self.quad = _vehicle(quad)
-        self.kp_pos = _gains("kp_pos", kp_pos, 3)
-        self.ki_vel = _gains("ki_vel", ki_vel, 3)
-        self._loops = Autopilot(quad, kp_rate, kp_att, kp_vel)
-        self.integral_limit = as_float("integral_limit", integral_limit, nonnegative=True)
-        self._integral = _Integral(self.ki_vel, self.integral_limit)
-
-    # The inner loops' gains are the autopilot's.
-    kp_vel = property(lambda self: self._loops.kp_vel, doc="velocity gain [1/s] (3,)")
-    kp_att = property(lambda self: self._loops.kp_att, doc="attitude gain [1/s]")
-    kp_rate = property(lambda self: self._loops.kp_rate, doc="body-rate gain [1/s]")
-
-    def reset(self) -> None:
-        """Forget the integral of the velocity error."""
-        self._integral.reset()
-
-    def update(self, t: float, reference) -> np.ndarray:
-        """Rotor speeds (4,) [rad/s] that steer the vehicle towards ``reference``."""
-        t = as_float("t", t)
-        (position, velocity, acceleration, _), yaw, yaw_rate = _reference_of(reference)
-        body = self.quad.body
-        velocity_error = velocity + self.kp_pos * (position - body.position) - body.velocity
-        acceleration = acceleration + self._loops.kp_vel * velocity_error + self._integral.update(t, velocity_error)
-        return self._loops._acceleration_to_speeds(acceleration, yaw, yaw_rate)
 
 
 def bad_rotor_speeds(controller, speeds: np.ndarray, t: float) -> ValueError:

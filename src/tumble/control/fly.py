@@ -1,5 +1,5 @@
 """``quad.fly(controller, trajectory)``: a flight attached to its vehicle's world as a controller, whose compiled
-stage (:class:`~tumble.flight.native.NativeFlights`) runs it in the kernels where it can."""
+stage (:class:`~tumble.control.native.NativeFlights`) runs it in the kernels where it can."""
 
 from __future__ import annotations
 
@@ -7,8 +7,8 @@ from typing import NamedTuple
 
 import numpy as np
 
-from . import bad_rotor_speeds
 from .native import NativeFlights
+from .se3 import bad_rotor_speeds
 
 __all__ = ["Flight", "fly"]
 
@@ -38,7 +38,7 @@ def fly(quad, controller, trajectory, rate: float | None = None):
             raise bad_rotor_speeds(controller, speeds, t)
         quad.command_rotor_speeds(speeds)
 
-    # The compiled flights (flight.native) can stand in for this callback; they read what it flies from it.
+    # The compiled flights (control.native) can stand in for this callback; they read what it flies from it.
     follow.compiled_stage = NativeFlights.for_world
     handle = quad.world.add_controller(follow, rate=rate, name=name)
     follow.flight = Flight(controller, trajectory, rate, handle, quad)

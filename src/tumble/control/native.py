@@ -22,9 +22,9 @@ from ..controllers import TICK_TOLERANCE, controller_failed
 from ..dynamics.actuation import advance_motors
 from ..dynamics.integrate import advance_rows
 from ..math3d import store3, store4
-from ..references import Circle, Hover, Lissajous, MinimumSnap
-from . import SE3Controller, bad_rotor_speeds
 from .kernels import reference_derivatives, se3_rotor_speeds
+from .se3 import SE3Controller, bad_rotor_speeds
+from .trajectories import Circle, Hover, Lissajous, MinimumSnap
 
 __all__ = ["FlightTable", "NativeFlights", "command_flights", "flight_table", "fly_steps"]
 
@@ -50,14 +50,14 @@ class FlightTable(NamedTuple):
     k_thrust: np.ndarray  # (f,)
     squared_limits: np.ndarray  # (f, 2)
     kind: np.ndarray  # (f,) int64: _HOVER, _CIRCLE, _LISSAJOUS, _MINIMUM_SNAP
-    params: np.ndarray  # (f, 11): see flight.kernels (HOVER and the others)
+    params: np.ndarray  # (f, 11): see control.kernels (HOVER and the others)
     knot_count: np.ndarray  # (f,) int64: MinimumSnap's waypoints
     knots: np.ndarray  # (f, k): MinimumSnap's times, padded
     coefficients: np.ndarray  # (f, k - 1, 8, 3): MinimumSnap's pieces, padded
 
 
 def _reference_spec(trajectory):
-    """The :class:`~tumble.references.ReferenceSpec` of a trajectory the kernel evaluates; None for others."""
+    """The :class:`~tumble.control.trajectories.ReferenceSpec` of a trajectory the kernel evaluates; None for others."""
     return trajectory.spec if type(trajectory) in (Hover, Circle, Lissajous, MinimumSnap) else None
 
 
@@ -118,7 +118,7 @@ def flight_table(world, controllers) -> FlightTable | None:
 @kernel
 def command_flights(table, gravity, acts, pos, quat, linvel, angmom, t, h, ref, speeds, integral):
     """Before the step of ``h`` that starts at ``t``: each flight that is due evaluates its reference and the SE(3)
-    law and commands its rotors (``tumble.flight.fly`` and ``_Integral``, in the order of the table). Returns the
+    law and commands its rotors (``tumble.control.fly`` and ``_Integral``, in the order of the table). Returns the
     first flight whose rotor speeds are not finite (then in ``speeds``), or -1. ``ref`` (5, 3), ``speeds`` (4,) and
     ``integral`` (3,) are scratch."""
     for f in range(table.body.shape[0]):

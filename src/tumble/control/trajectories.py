@@ -15,9 +15,9 @@ from typing import NamedTuple
 
 import numpy as np
 
-from . import portable
-from ._validate import as_array, as_float, as_vector3
-from .flight.kernels import CIRCLE, HOVER, LISSAJOUS, MINIMUM_SNAP, reference_derivatives
+from .. import portable
+from .._validate import as_array, as_float, as_vector3
+from .kernels import CIRCLE, HOVER, LISSAJOUS, MINIMUM_SNAP, reference_derivatives
 
 __all__ = ["Circle", "Hover", "Lissajous", "MinimumSnap"]
 
