@@ -1,0 +1,61 @@
+"""The walk of a step (issue 45, part 4): ``dt`` from ``World.step`` reaches the pipeline through the stepping room
+and the runner only, and a plain step calls no vehicle or flight code (``docs/step.md`` shows the same path)."""
+
+from __future__ import annotations
+
+import sys
+
+import tumble
+
+
+def _calls_of_one_step(world: tumble.World) -> tuple[list[str], list[str]]:
+    """``(stack, visited)``: the tumble modules on the stack when ``pipeline.contact_step`` is entered, outermost
+    first (each once), and every tumble module the step called into."""
+    stack: list[str] = []
+    visited: set[str] = set()
+
+    def profile(frame, event, arg):
+        if event != "call":
+            return
+        module = frame.f_globals.get("__name__", "")
+        if not module.startswith("tumble"):
+            return
+        visited.add(module)
+        if module == "tumble.pipeline" and frame.f_code.co_name == "contact_step" and not stack:
+            outer = frame
+            while outer is not None:
+                name = outer.f_globals.get("__name__", "")
+                if name.startswith("tumble") and (not stack or stack[-1] != name):
+                    stack.append(name)
+                outer = outer.f_back
+
+    sys.setprofile(profile)
+    try:
+        world.step(1.0 / 60.0)
+    finally:
+        sys.setprofile(None)
+    return stack[::-1], sorted(visited)
+
+
+def test_dt_from_world_step_reaches_the_pipeline_through_the_runner_only():
+    world = tumble.World()
+    world.add_static(tumble.Plane())
+    world.add_body(tumble.Box((0.1, 0.1, 0.1)), mass=1.0, position=(0.0, 0.0, 0.2))
+    world.step(1.0 / 60.0)  # the model built and the kernels loaded before the walk is watched
+    stack, visited = _calls_of_one_step(world)
+    assert stack == ["tumble.world", "tumble.world_stepping", "tumble.runner", "tumble.pipeline"]
+    assert not [m for m in visited if m.split(".")[1] in ("control", "vehicles")]
+
+
+def test_a_world_with_a_flown_quadrotor_steps_through_the_same_walk():
+    from tumble.control import Hover, SE3Controller
+    from tumble.vehicles import Quadrotor
+
+    world = tumble.World()
+    world.add_static(tumble.Plane())
+    quad = Quadrotor(world, position=(0.0, 0.0, 1.0))
+    quad.fly(SE3Controller(quad), Hover((0.0, 0.0, 1.0)))
+    world.step(1.0 / 100.0)
+    stack, visited = _calls_of_one_step(world)
+    assert stack == ["tumble.world", "tumble.world_stepping", "tumble.runner", "tumble.pipeline"]
+    assert "tumble.control.fly" in visited  # the flight ran as a controller, before the step
