@@ -20,14 +20,8 @@ __all__ = ["checked_step", "simulate", "step"]
 
 
 def step(world, dt: float) -> None:
-    """Advance one step of ``dt`` seconds. Applied forces act during this step only.
-
-    Raises:
-        ValueError: ``dt`` does not advance the time, or its contacts would need more than 65 536 substeps
-            (``solver.substeps_for(dt)``); nothing has moved.
-        SimulationError: the step produced a non-finite value; the world keeps its state from before, and the
-            loads applied for the step are dropped (so that the next step can succeed).
-    """
+    """``World.step``: the controllers due, one step of ``dt`` by the runner, the sensors' samples (or a
+    :class:`SimulationError` for the failing body, the world as it was)."""
     dt = checked_step(world, dt)
     failing = _controlled_step(world, dt)
     if failing >= 0:
@@ -85,11 +79,8 @@ def _actuators_for_step(world, dt: float):
 
 
 def simulate(world, duration: float, dt: float, record_every: int = 1) -> Trajectory:
-    """Take ``round(duration / dt)`` steps in one compiled loop, recording every ``record_every`` steps.
-
-    The trajectory starts with the current state. On a :class:`SimulationError` the world keeps its last
-    good state and the error's ``trajectory`` holds the frames recorded up to it.
-    """
+    """``World.simulate``: one call of the runner for all the steps, or a Python loop of :func:`step`'s parts where
+    controllers, sensors or a changing wind need one; the trajectory, or the error carrying it."""
     duration = as_float("duration", duration, positive=True)
     dt = checked_step(world, dt)
     record_every = as_count("record_every", record_every)

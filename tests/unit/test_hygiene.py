@@ -16,8 +16,9 @@ def _module(path: Path) -> str:
     return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
 
 
-def _imports(path: Path) -> set[str]:
-    """The tumble modules ``path`` imports, at its top or inside a function (a lazy import is still a dependency)."""
+def _imports(path: Path, modules) -> set[str]:
+    """The tumble modules of ``modules`` that ``path`` imports, at its top or inside a function (a lazy import is
+    still a dependency). ``from . import module`` imports that module; ``from .control import name``, the package."""
     module = _module(path)
     package = module if path.name == "__init__.py" else module.rpartition(".")[0]
     found = set()
@@ -25,11 +26,10 @@ def _imports(path: Path) -> set[str]:
         if isinstance(node, ast.ImportFrom):
             base = package.split(".")[: len(package.split(".")) - (node.level - 1)] if node.level else []
             target = ".".join(base + ([node.module] if node.module else []))
-            found.add(target)
-            found.update(f"{target}.{alias.name}" for alias in node.names)  # ``from . import module``
+            found.update(f"{target}.{a.name}" if f"{target}.{a.name}" in modules else target for a in node.names)
         elif isinstance(node, ast.Import):
             found.update(alias.name for alias in node.names)
-    return found
+    return {m for m in found if m in modules and m != module}
 
 
 def _import_graph() -> dict[str, set[str]]:
@@ -37,11 +37,7 @@ def _import_graph() -> dict[str, set[str]]:
     so an import of a package is left out (else every module of it would sit in a circle with its package)."""
     paths = {_module(p): p for p in (SOURCE / "tumble").rglob("*.py")}
     packages = {name for name, p in paths.items() if p.name == "__init__.py"}
-    return {
-        name: {m for m in _imports(p) if m in paths and m not in packages and m != name}
-        for name, p in paths.items()
-        if name not in packages
-    }
+    return {name: _imports(p, paths) - packages for name, p in paths.items() if name not in packages}
 
 
 def _cycles(graph: dict[str, set[str]]) -> list[list[str]]:
@@ -120,20 +116,7 @@ def _graph_with_packages() -> dict[str, set[str]]:
     """Module -> the modules it imports, packages included: a package's ``__init__`` that holds code (``control``'s
     names, the root's) is a module like any other, reached by ``from .control import SE3Controller``."""
     paths = {_module(p): p for p in (SOURCE / "tumble").rglob("*.py")}
-    graph = {}
-    for name, path in paths.items():
-        package = name if path.name == "__init__.py" else name.rpartition(".")[0]
-        found = set()
-        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
-            if isinstance(node, ast.ImportFrom):
-                base = package.split(".")[: len(package.split(".")) - (node.level - 1)] if node.level else []
-                target = ".".join(base + ([node.module] if node.module else []))
-                # ``from . import module`` imports the module; ``from .flight import name``, the package's code.
-                found.update(f"{target}.{a.name}" if f"{target}.{a.name}" in paths else target for a in node.names)
-            elif isinstance(node, ast.Import):
-                found.update(alias.name for alias in node.names)
-        graph[name] = {m for m in found if m in paths and m != name}
-    return graph
+    return {name: _imports(path, paths) for name, path in paths.items()}
 
 
 def _engine_imports_above(graph: dict[str, set[str]]) -> set[tuple[str, str]]:
