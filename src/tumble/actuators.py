@@ -24,7 +24,7 @@ from ._validate import as_float, as_unit_vector3, as_vector3
 from .dynamics.actuation import ROTOR, THRUSTER, ActuatorArrays
 from .handles import as_body, as_dynamic_body_of, as_new_part
 
-__all__ = ["Actuator", "Rotor", "Thruster", "command_all"]
+__all__ = ["Actuator", "Rotor", "Thruster", "command_all", "packed_rows"]
 
 
 class Actuator:
@@ -155,17 +155,26 @@ class Thruster(Actuator):
         return f"<Thruster on body {self.body.name or self.body.index!r}: {self.commanded_force:.6g} N>"
 
 
+def packed_rows(actuators) -> list[int] | None:
+    """The rows of ``actuators`` in their world's packed arrays (``ActuatorArrays``), or None unless all of them sit
+    in the same packed arrays now (the arrays are rebuilt, and the rows dropped, when actuators are added)."""
+    owner = actuators[0]._owner
+    if owner is None or any(actuator._owner is not owner for actuator in actuators):
+        return None
+    return [actuator._row for actuator in actuators]
+
+
 def command_all(rotors, speeds: np.ndarray) -> None:
     """``rotor.command(speed)`` for each pair, in one write when the rotors share their world's arrays (a vehicle
     commanded at every step of a fast world)."""
-    owner = rotors[0]._owner
-    if owner is None or any(rotor._owner is not owner for rotor in rotors):
+    rows = packed_rows(rotors)
+    if rows is None:
         for rotor, speed in zip(rotors, speeds, strict=True):
             rotor.command(float(speed))
         return
     low = [rotor.speed_min for rotor in rotors]
     high = [rotor.speed_max for rotor in rotors]
-    owner.arrays.command[[rotor._row for rotor in rotors]] = np.minimum(np.maximum(speeds, low), high)
+    rotors[0]._owner.arrays.command[rows] = np.minimum(np.maximum(speeds, low), high)
     rotors[0].body._require_dynamic("command an actuator")
     for rotor in rotors[1:]:
         if rotor.body is not rotors[0].body:

@@ -49,6 +49,11 @@ class Controller:
         """Stop running this controller (removing it twice is an error)."""
         self._owner.remove(self)
 
+    @property
+    def next_tick(self) -> int:
+        """The index ``k`` of the next tick ``k / rate`` (0 for a controller of every step)."""
+        return self._next_tick
+
     def count_calls(self, calls: int, next_tick: int) -> None:
         """Count ``calls`` made in its place (by a compiled stage), whose next tick is now ``next_tick``."""
         self.calls += int(calls)

@@ -18,6 +18,7 @@ from typing import NamedTuple
 import numpy as np
 
 from .._jit import kernel
+from ..actuators import packed_rows
 from ..controllers import TICK_TOLERANCE, controller_failed
 from ..dynamics.actuation import advance_motors
 from ..dynamics.integrate import advance_rows
@@ -73,20 +74,20 @@ def flight_table(world, controllers) -> FlightTable | None:
         if reference is None:
             return None
         quad, law = flight.quad, flight.controller
-        owner = quad.rotors[0]._owner
-        if owner is None or any(r._owner is not owner for r in quad.rotors):
+        rotor_rows = packed_rows(quad.rotors)
+        if rotor_rows is None:
             return None
-        rows.append((quad, law, controller, reference))
+        rows.append((quad, law, controller, reference, rotor_rows, law._integral_state()))
     if not rows:
         return None
     size = max(r[3].knots.shape[0] for r in rows)
     table = FlightTable(
         body=np.array([q.body.index for q, *_ in rows], np.int64),
-        rows=np.array([[rotor._row for rotor in q.rotors] for q, *_ in rows], np.int64),
+        rows=np.array([r[4] for r in rows], np.int64),
         speed_min=np.array([[rotor.speed_min for rotor in q.rotors] for q, *_ in rows], float),
         speed_max=np.array([[rotor.speed_max for rotor in q.rotors] for q, *_ in rows], float),
-        rate=np.array([c.rate or 0.0 for _, _, c, _ in rows], float),
-        next_tick=np.array([c._next_tick for _, _, c, _ in rows], np.int64),
+        rate=np.array([r[2].rate or 0.0 for r in rows], float),
+        next_tick=np.array([r[2].next_tick for r in rows], np.int64),
         calls=np.zeros(len(rows), np.int64),
         mass=np.array([q.params["mass"] for q, *_ in rows], float),
         inertia=np.array([q.params["inertia"] for q, *_ in rows], float),
@@ -99,8 +100,8 @@ def flight_table(world, controllers) -> FlightTable | None:
             float,
         ),  # fmt: skip
         feedforward=np.array([law.feedforward for _, law, *_ in rows], np.bool_),
-        integral=np.array([law._integral_state()[0] for _, law, *_ in rows], float),
-        last_time=np.array([law._integral_state()[1] for _, law, *_ in rows], float),
+        integral=np.array([r[5][0] for r in rows], float),
+        last_time=np.array([r[5][1] for r in rows], float),
         mixer_inverse=np.array([q.mixer.inverse for q, *_ in rows], float),
         k_thrust=np.array([q.params["k_thrust"] for q, *_ in rows], float),
         squared_limits=np.array([q.mixer.squared_limits for q, *_ in rows], float),
