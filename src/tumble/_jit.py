@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import functools
 import hashlib
+import inspect
 from pathlib import Path
 from types import FunctionType
 
@@ -67,13 +68,17 @@ class _PackageStamp:
     """
 
     def get_source_stamp(self):
-        return _package_stamp(_leaf_of(_resolved(self._py_file)))
+        return _package_stamp(self._leaf)
 
     @classmethod
     def from_function(cls, py_func, py_file):
         if not _resolved(py_file).is_relative_to(_PACKAGE_DIR):
             return None
-        return super().from_function(py_func, py_file)
+        locator = super().from_function(py_func, py_file)
+        if locator is not None:
+            # A copy made by kernel_for embeds the functions bound into it: their leaf package stamps it too.
+            locator._leaf = getattr(py_func, "_bound_leaf", None) or _leaf_of(_resolved(py_file))
+        return locator
 
 
 @functools.cache
@@ -155,8 +160,15 @@ def kernel_for(template, name: str, **names):
     compiled copy per binding, so that a caller compiles only the copies it runs (``narrow_phase`` makes one loop
     per pair type this way). A closure would do the same, but Numba keys its cache on the pickled closure, which
     holds a per-process id for a compiled function: the copies would never load from the cache. Each copy is
-    named ``name``, which also names its cache files."""
+    named ``name``, which also names its cache files. A copy that binds a leaf package's function (a compiled
+    controller stage into the core's step loop) is stamped with that package's sources as well as its own."""
+    functions = [getattr(value, "py_func", value) for value in names.values()]
+    files = [_resolved(inspect.getfile(f)) for f in functions if isinstance(f, FunctionType)]
+    leaves = {_leaf_of(path) for path in files if path.is_relative_to(_PACKAGE_DIR)} - {None}
+    if len(leaves) > 1:
+        raise ValueError(f"kernel_for binds functions of several leaf packages ({sorted(leaves)}) into {name!r}")
     copy = FunctionType(template.__code__, {**template.__globals__, **names}, name)
+    copy._bound_leaf = leaves.pop() if leaves else None
     copy.__qualname__ = name
     copy.__module__ = template.__module__
     copy.__doc__ = template.__doc__

@@ -30,7 +30,7 @@ from . import portable
 from ._validate import _show, as_array, as_count, as_step, listed
 from .batch_rows import DRIVE_TARGET, copy_impulses, rows_model, splice_contacts, tiled_impulses
 from .dynamics.actuation import ActuatorArrays
-from .dynamics.integrate import _thread_pool, threads
+from .dynamics.integrate import thread_pool, threads
 from .errors import SimulationError
 from .inputs import Inputs
 from .runner import simulate_steps
@@ -388,8 +388,8 @@ class Batch:
             self._stale = False
         if free:  # one call for every step: the kernel keeps the last step all rows completed
             block = self._blocks[0]
-            _, row = simulate_steps(block.model, block.state, block.inputs, self._params, block.scratch, dt, steps,
-                                    acts=block.acts)  # fmt: skip
+            row = simulate_steps(block.model, block.state, block.inputs, self._params, block.scratch, dt, steps,
+                                 acts=block.acts).failing_body  # fmt: skip
             failure = None if row < 0 else divmod(row, self.body_count)
         else:
             failure = self._step_blocks(dt, steps)
@@ -405,7 +405,7 @@ class Batch:
             before = [block.state.copy() for block in blocks] if len(blocks) > 1 else None
             if workers > 1:
                 errors = np.geterr()  # NumPy's error settings are per thread: the caller's hold in the workers too
-                futures = [_thread_pool().submit(self._step_block, block, dt, errors) for block in blocks]
+                futures = [thread_pool().submit(self._step_block, block, dt, errors) for block in blocks]
                 rows = [future.result() for future in futures]
             else:
                 rows = [self._step_block(block, dt) for block in blocks]
@@ -426,9 +426,8 @@ class Batch:
         if errors is not None:
             with np.errstate(**errors):
                 return self._step_block(block, dt)
-        _, row = simulate_steps(block.model, block.state, block.inputs, self._params, block.scratch, dt, 1,
-                                acts=block.acts)  # fmt: skip
-        return row
+        return simulate_steps(block.model, block.state, block.inputs, self._params, block.scratch, dt, 1,
+                              acts=block.acts).failing_body  # fmt: skip
 
     def _failed(self, c: int, body: int) -> SimulationError:
         name = self._base.body_name[body]

@@ -149,9 +149,12 @@ class Controllers:
         - ``command(model, state, acts, t, dt)``: before the step of ``dt`` from ``t`` (counted by the world's
           :class:`StepClock`), the due controllers write their commands into the actuator arrays ``acts``; a
           controller that fails raises :func:`controller_failed`'s error, the world as it was;
-        - ``fly_free(model, state, inputs, acts, scratch, recording, dt, n_steps, method, record_every, clock)``:
-          every step of a world of free bodies in one compiled call, the commands between them; returns
-          ``(steps_done, failing_body, error)`` as the Python loop does (``clock``: ``(origin_time, steps since it)``);
+        - ``compiled_command`` and ``compiled_data``: a compiled function ``compiled_command(compiled_data, gravity,
+          acts, pos, quat, linvel, angmom, t, h)`` that does what ``command`` does and returns the index of the
+          controller that failed, or -1. The runner's compiled loop (``tumble.runner``) calls it before each step of
+          a world of free bodies, so that all the steps of ``simulate`` take one call;
+        - ``failure(index, t, step)``: the error of the controller ``compiled_command`` said failed, before the step
+          ``step`` from ``t``;
         - ``finish()``: the calls made, the next ticks and the controllers' own state handed back to them.
         """
         makers = {getattr(controller.callback, "compiled_stage", None) for controller in self._items}

@@ -1,9 +1,9 @@
 """One step of a world: the order of the stages, and nothing else (no arithmetic here).
 
-Free bodies (nothing can touch) take all the steps of a call at once, body by body, in one compiled kernel that the
-runner calls (runner.py):
+Free bodies (nothing can touch) take all the steps of a call at once, body by body, in the runner's compiled loop
+(runner.py):
 
-    advance_free_bodies   model.body_*, inputs  -> state.body_*            (dynamics/integrate.py)
+    advance_rows          model.body_*, inputs  -> state.body_*            (dynamics/integrate.py)
 
 Bodies with contacts (the soft step of DESIGN.md):
 

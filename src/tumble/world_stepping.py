@@ -12,7 +12,7 @@ import numpy as np
 
 from ._validate import as_count, as_float, as_step, step_count
 from .errors import SimulationError
-from .runner import advance_clock, record_frame, simulate_steps
+from .runner import simulate_steps, step_by_step
 from .trajectory import Trajectory
 from .wind import Constant
 
@@ -51,8 +51,8 @@ def _controlled_step(world, dt: float, stage=None) -> int:
         stage.command(world._model, world._state, world._actuation.arrays, _next_step_time(world, dt), dt)
     world._sync()
     world._sensors.before_step(world)
-    _, failing = simulate_steps(world._model, world._state, world._inputs, world._params, world._scratch, dt,
-                                acts=_actuators_for_step(world, dt))  # fmt: skip
+    failing = simulate_steps(world._model, world._state, world._inputs, world._params, world._scratch, dt,
+                             acts=_actuators_for_step(world, dt)).failing_body  # fmt: skip
     if failing < 0:
         world._sensors.sample(world, dt)
     return failing
@@ -96,7 +96,7 @@ def simulate(world, duration: float, dt: float, record_every: int = 1) -> Trajec
     elif world._controllers or world._sensors or not isinstance(world._wind, (Constant, type(None))):
         steps_done, failing, controller_error = _simulate_stepwise(world, dt, n_steps, recording, int(record_every))
     else:
-        steps_done, failing = simulate_steps(
+        steps_done, failing, _ = simulate_steps(
             world._model,
             world._state,
             world._inputs,
@@ -136,31 +136,36 @@ def _simulate_stage(world, stage, dt: float, n_steps: int, recording, record_eve
     if world._model.has_constraints or world._sensors or not isinstance(world._wind, (Constant, type(None))):
         result = _simulate_stepwise(world, dt, n_steps, recording, record_every, stage=stage)
     else:
-        acts = _actuators_for_step(world, dt)
         state = world._state
         clock = world._clock.count(state.time, state.step_count, dt)
-        result = stage.fly_free(world._model, state, world._inputs, acts, world._scratch, recording, dt, n_steps,
-                                int(world._params.resolve_integrator(False)), record_every, clock)  # fmt: skip
-        advance_clock(state, dt, result[0])
-        world._inputs.clear()  # as simulate_steps: used, or dropped with a failed first step
+        steps = simulate_steps(world._model, state, world._inputs, world._params, world._scratch, dt, n_steps,
+                               recording, record_every, _actuators_for_step(world, dt), stage, clock)  # fmt: skip
+        error = None
+        if steps.failing_controller >= 0:  # before the step ``steps.done``, at its counted start time
+            origin_time, origin_count = clock
+            t = origin_time + (origin_count + steps.done) * dt
+            error = stage.failure(steps.failing_controller, t, state.step_count)
+        result = steps.done, steps.failing_body, error
     stage.finish()
     return result
 
 
 def _simulate_stepwise(world, dt: float, n_steps: int, recording, record_every: int, stage=None):
-    """Step by step from Python, the controllers (or the compiled ``stage``) before each step and the sensors
-    after it: ``(steps_done, failing_body, error)``."""
-    for step in range(n_steps):
-        try:
-            failing = _controlled_step(world, dt, stage)
-        except SimulationError as error:
-            return step, -1, error
+    """Step by step in the runner's Python loop, the controllers (or the compiled ``stage``) before each step and
+    the sensors after it: ``(steps_done, failing_body, error)``."""
+    start = world._state.step_count
+
+    def one_step(step: int) -> int:
+        failing = _controlled_step(world, dt, stage)
         if world._state.body_count != recording.pos.shape[1]:
             raise ValueError("a controller added bodies during simulate; add them before it, or between calls")
-        if failing >= 0:
-            return step, failing, None
-        record_frame(recording, record_every, step, world._state)
-    return n_steps, -1, None
+        return failing
+
+    try:
+        steps = step_by_step(n_steps, one_step, recording, record_every, world._state)
+    except SimulationError as error:  # a controller raised before a step: the steps before it are done
+        return world._state.step_count - start, -1, error
+    return steps.done, steps.failing_body, None
 
 
 def _simulation_error(world, row: int) -> SimulationError:

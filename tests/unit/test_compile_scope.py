@@ -140,8 +140,9 @@ def test_touching_manifolds_move_to_the_front_in_pair_order():
 def test_the_free_body_integrator_compiles_its_per_body_calls_into_the_row_loop():
     """A compiled call reference-counts every array it receives: the per-body functions of the free-body integrator
     are compiled into their callers (Numba's ``inline="always"``), or every body would pay that once per call."""
+    from tumble import runner
     from tumble.dynamics import integrate
 
-    for helper in (integrate.advance_rows, integrate._body_steps, integrate._save_row):
+    for helper in (integrate.advance_rows, integrate._body_steps, runner._save_row, runner._restore_row):
         assert helper.targetoptions.get("inline") == "always", helper.py_func.__name__
     assert "inline" not in math3d.dot.targetoptions  # the other helpers are left to LLVM

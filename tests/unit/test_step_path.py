@@ -59,3 +59,29 @@ def test_a_world_with_a_flown_quadrotor_steps_through_the_same_walk():
     stack, visited = _calls_of_one_step(world)
     assert stack == ["tumble.world", "tumble.world_stepping", "tumble.runner", "tumble.pipeline"]
     assert "tumble.control.fly" in visited  # the flight ran as a controller, before the step
+
+
+def test_a_flown_quadrotor_takes_every_step_of_simulate_in_one_call_of_the_runners_loop():
+    """Free bodies with a compiled controller stage: the runner's one compiled loop takes all the steps, the stage
+    bound into it (issue 45, part 1); no flight code keeps a loop of its own."""
+    from tumble.control import Hover, SE3Controller, native
+    from tumble.vehicles import Quadrotor
+
+    world = tumble.World()
+    quad = Quadrotor(world, position=(0.0, 0.0, 1.0))
+    quad.fly(SE3Controller(quad), Hover((0.0, 0.0, 1.0)))
+    world.simulate(0.01, 1e-3)  # the kernels loaded before the calls are counted
+    calls: list[str] = []
+
+    def profile(frame, event, arg):
+        if event == "call" and frame.f_globals.get("__name__") == "tumble.runner":
+            calls.append(frame.f_code.co_name)
+
+    sys.setprofile(profile)
+    try:
+        world.simulate(0.1, 1e-3)
+    finally:
+        sys.setprofile(None)
+    assert calls.count("simulate_steps") == 1 and calls.count("_free_body_steps") == 1
+    assert world.step_count == 110
+    assert not hasattr(native, "fly_steps") and not hasattr(native.NativeFlights, "fly_free")

@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from .._validate import _show, as_array, as_count, as_step, require_memory
-from ..dynamics.integrate import _thread_pool, threads
+from ..dynamics.integrate import thread_pool, threads
 from ..errors import SimulationError
 from .articulation import Articulation, _check_integrator, unit_quaternions
 from .integrators import NOT_FINITE
@@ -144,7 +144,7 @@ class ArticulationBatch:
             if self._work.shape[0] < workers:
                 self._work = np.zeros((workers, self._work_size))
             bounds = np.linspace(0, self._n, workers + 1).astype(np.int64)
-            futures = [_thread_pool().submit(batch_kernel, self._ints, self._reals, self._q, self._qd, self._tau,
+            futures = [thread_pool().submit(batch_kernel, self._ints, self._reals, self._q, self._qd, self._tau,
                                              self._work[k], self._external, dt, method, steps, int(bounds[k]),
                                              int(bounds[k + 1]), self._failures)
                        for k in range(workers)]  # fmt: skip

@@ -1,13 +1,14 @@
 """Flights in the kernels: when a world's only controllers are ``quad.fly(SE3Controller(...), Hover | Circle |
 Lissajous | MinimumSnap)``, ``world.simulate`` evaluates them with :func:`command_flights`, one kernel call for all
-of them, instead of a Python controller each; a world of free bodies (no contacts or joints, no sensors, a constant
-wind) takes every step and flight in one call (:func:`fly_steps`). :class:`NativeFlights` is the compiled stage
-the world's controllers hand the run to (``tumble.controllers.Controllers.compiled_stage``).
+of them, instead of a Python controller each. :class:`NativeFlights` is the compiled stage the world's controllers
+hand the run to (``tumble.controllers.Controllers.compiled_stage``); a world of free bodies (no contacts or joints,
+no sensors, a constant wind) takes every step and flight in one call of the runner's loop (``tumble.runner``), which
+calls :func:`command_stage` before each step.
 
 It does what the step-by-step path does, in the same order and with the same kernels: at each step's counted start
 time the flights that are due evaluate their reference (``reference_derivatives``) and the SE(3) law
-(``se3_rotor_speeds``) and command their rotors; every body takes one step of the same integrator (``advance_rows``
-with one step); the motors advance by ``h``. The two paths fly bit for bit alike.
+(``se3_rotor_speeds``) and command their rotors; then the runner steps the bodies and the motors. The two paths fly
+bit for bit alike.
 """
 
 from __future__ import annotations
@@ -17,17 +18,14 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .._jit import kernel
+from .._jit import inline, kernel
 from ..actuators import packed_rows
 from ..controllers import TICK_TOLERANCE, controller_failed
-from ..dynamics.actuation import advance_motors
-from ..dynamics.integrate import advance_rows
-from ..math3d import store3, store4
 from .kernels import reference_derivatives, se3_rotor_speeds
 from .se3 import SE3Controller, bad_rotor_speeds
 from .trajectories import Circle, Hover, Lissajous, MinimumSnap
 
-__all__ = ["FlightTable", "NativeFlights", "command_flights", "flight_table", "fly_steps"]
+__all__ = ["FlightTable", "NativeFlights", "command_flights", "command_stage", "flight_table"]
 
 
 class FlightTable(NamedTuple):
@@ -158,50 +156,25 @@ def command_flights(table, gravity, acts, pos, quat, linvel, angmom, t, h, ref, 
     return -1
 
 
-@kernel
-def fly_steps(table, bodies, gravity, force, torque, zero, acts, pos, quat, linvel, angmom, backup, no_recording, rec,
-              h, n_steps, method, record_every, origin_time, origin_count, ref, speeds):  # fmt: skip
-    """``n_steps`` steps of ``h`` of a world of free bodies: before each, :func:`command_flights`; then every body
-    one step, the motors ``h`` on, the frame recorded. The step ``s`` starts at ``origin_time + (origin_count + s)
-    h``, as ``tumble.control.StepClock`` counts. Returns ``(steps_done, failing_body, failing_flight)`` (-1: none);
-    on a failure the bodies are as before that step, and ``speeds`` holds what a failing flight asked for."""
-    integral = np.zeros(3)
-    failed_step = np.empty(pos.shape[0], np.int64)
-    for s in range(n_steps):
-        failing = command_flights(table, gravity, acts, pos, quat, linvel, angmom, origin_time + (origin_count + s) * h,
-                                  h, ref, speeds, integral)  # fmt: skip
-        if failing >= 0:
-            return s, -1, failing
-        body_count = pos.shape[0]
-        for i in range(body_count):
-            store3(backup[0], i, (pos[i, 0], pos[i, 1], pos[i, 2]))
-            store4(backup[1], i, (quat[i, 0], quat[i, 1], quat[i, 2], quat[i, 3]))
-            store3(backup[2], i, (linvel[i, 0], linvel[i, 1], linvel[i, 2]))
-            store3(backup[3], i, (angmom[i, 0], angmom[i, 1], angmom[i, 2]))
-        loads_f, loads_t = (force, torque) if s == 0 else (zero, zero)
-        advance_rows(0, body_count, bodies, gravity, loads_f, loads_t, acts, pos, quat, linvel, angmom, no_recording,
-                     failed_step, h, 1, method, 0)  # fmt: skip
-        for i in range(body_count):
-            if failed_step[i] >= 0:
-                pos[:, :], quat[:, :], linvel[:, :], angmom[:, :] = backup[0], backup[1], backup[2], backup[3]
-                return s, i, -1
-        advance_motors(acts, h)
-        if record_every > 0 and (s + 1) % record_every == 0:
-            frame = (s + 1) // record_every - 1
-            rec.pos[frame, :, :] = pos
-            rec.quat[frame, :, :] = quat
-            rec.linvel[frame, :, :] = linvel
-            rec.angmom[frame, :, :] = angmom
-    return n_steps, -1, -1
+@inline
+def command_stage(data, gravity, acts, pos, quat, linvel, angmom, t, h):
+    """:func:`command_flights` as the runner's compiled loop calls a stage (``tumble.runner``): ``data`` is
+    :attr:`NativeFlights.compiled_data`, the table and its scratch."""
+    table, ref, speeds, integral = data
+    return command_flights(table, gravity, acts, pos, quat, linvel, angmom, t, h, ref, speeds, integral)
 
 
 class NativeFlights:
     """The compiled stage of a world whose controllers are all native flights (see
     ``tumble.controllers.Controllers.compiled_stage`` for what a stage does): :func:`command_flights` before each
-    step of a Python loop, or :func:`fly_steps` for every step of a world of free bodies."""
+    step, from a Python loop (:meth:`command`) or from the runner's compiled loop (:func:`command_stage`)."""
+
+    compiled_command = staticmethod(command_stage)
 
     def __init__(self, controllers: list, table: FlightTable):
         self._controllers, self._table = controllers, table
+        self._speeds = np.zeros(4)  # what the last flight that ran asked for
+        self.compiled_data = (table, np.zeros((5, 3)), self._speeds, np.zeros(3))
 
     @classmethod
     def for_world(cls, world, controllers) -> NativeFlights | None:
@@ -212,25 +185,10 @@ class NativeFlights:
         return cls(controllers, table)
 
     def command(self, model, state, acts, t: float, dt: float) -> None:
-        speeds = np.zeros(4)
         failing = command_flights(self._table, model.gravity, acts, state.body_pos, state.body_quat, state.body_linvel,
-                                  state.body_angmom, t, dt, np.zeros((5, 3)), speeds, np.zeros(3))  # fmt: skip
+                                  state.body_angmom, t, dt, *self.compiled_data[1:])  # fmt: skip
         if failing >= 0:
-            raise self._failed(failing, speeds, t, state.step_count)
-
-    def fly_free(self, model, state, inputs, acts, scratch, recording, dt, n_steps, method, record_every, clock):
-        origin_time, origin_count = clock
-        speeds = np.zeros(4)
-        steps, failing, flight = fly_steps(
-            self._table, model.body_arrays, model.gravity, inputs.body_force, inputs.body_torque,
-            np.zeros_like(inputs.body_force), acts, state.body_pos, state.body_quat, state.body_linvel,
-            state.body_angmom, scratch.backup, scratch.no_recording, recording, dt, n_steps, method, record_every,
-            origin_time, origin_count, np.zeros((5, 3)), speeds,
-        )  # fmt: skip
-        error = None
-        if flight >= 0:  # before the step ``steps``, at its counted start time
-            error = self._failed(flight, speeds, origin_time + (origin_count + steps) * dt, state.step_count + steps)
-        return steps, failing, error
+            raise self.failure(failing, t, state.step_count)
 
     def finish(self) -> None:
         table = self._table
@@ -239,7 +197,9 @@ class NativeFlights:
             law = controller.callback.flight.controller
             law._load_integral_state(table.integral[k], table.last_time[k])
 
-    def _failed(self, flight: int, speeds: np.ndarray, t: float, step: int):
+    def failure(self, flight: int, t: float, step: int):
+        """The error of flight ``flight`` (its index in the table), whose rotor speeds were not finite before the
+        step ``step`` from ``t``."""
         controller = self._controllers[flight]
-        return controller_failed(controller.name, bad_rotor_speeds(controller.callback.flight.controller, speeds, t),
-                                 t, step)  # fmt: skip
+        return controller_failed(controller.name, bad_rotor_speeds(controller.callback.flight.controller,
+                                                                   self._speeds, t), t, step)  # fmt: skip

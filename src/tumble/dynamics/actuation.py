@@ -101,9 +101,10 @@ def actuator_wrench(acts, i, tau, q, v, w):
 
 
 @kernel
-def advance_motors(acts, elapsed):
-    """Every rotor's speed ``elapsed`` seconds on; a thruster's force becomes its command. Writes: acts.speed."""
-    for r in range(acts.speed.shape[0]):
+def advance_motors(acts, first_body, last_body, elapsed):
+    """The speed of every rotor of bodies ``first_body..last_body-1`` ``elapsed`` seconds on; a thruster's force
+    becomes its command. Writes: acts.speed."""
+    for r in range(acts.first[first_body], acts.first[last_body]):
         if acts.kind[r] == THRUSTER:
             acts.speed[r] = acts.command[r]
         else:

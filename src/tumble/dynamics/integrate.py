@@ -1,16 +1,14 @@
-"""Free motion of every dynamic body over ``n`` steps, with recording and a guard against non-finite values.
+"""Free motion of a block of bodies over a range of steps (:func:`advance_rows`), and the threads it runs on.
 
-Without contacts or joints the bodies do not interact, so each body is carried through all ``n`` steps in
+Without contacts or joints the bodies do not interact, so each body is carried through all its steps in
 registers before the next one (body-major order). That is cache friendly, lets the bodies run in parallel
 with each row written by one thread only, and gives bit-identical results in any order or thread count.
+The loop of steps around it, with the backup, the restore on a non-finite value, the motors and a compiled
+controller stage between steps, is the runner's (``tumble.runner``).
 
-Large calls split the bodies into one contiguous block per core and run the same kernel on each block in a
+Large calls split the bodies into one contiguous block per core and run the runner's kernel on each block in a
 thread (the kernel releases the GIL). Set ``TUMBLE_THREADS=1`` to stay on one thread (``auto``, unset or empty:
 one per core; anything else is warned about and read as ``auto``).
-
-If a body's state becomes non-finite, its row keeps the last good values and the kernel reports the first
-failing step; :func:`advance_free_bodies` then restores every body to where it stood before the call and
-replays exactly the steps that all bodies completed, so the world stops at its last good state.
 """
 
 from __future__ import annotations
@@ -24,19 +22,16 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .._jit import inline, kernel
+from .._jit import inline
 from ..math3d import add_scaled, is_finite3, load3, load4, load33, quat_is_finite, store3, store4
-from ..model import Model
-from ..params import Integrator
-from ..state import State
 from .free_motion import euler_step, flies_freely, flight_step, midpoint_step, rk4_step, spin_turn, symplectic_step
 
 __all__ = [
     "Recording",
-    "advance_free_bodies",
     "advance_rows",
     "PARALLEL_MIN_WORK",
     "thread_count",
+    "thread_pool",
     "threads",
     "using_threads",
 ]
@@ -90,9 +85,11 @@ def empty_recording(body_count: int) -> Recording:
 
 @inline(into_callers=True)
 def advance_rows(first, last, bodies, gravity, force, torque, acts, pos, quat, linvel, angmom, rec, failed_step, h,
-                 n_steps, method, record_every):  # fmt: skip
-    """Carry bodies ``first..last-1`` through ``n_steps``: ``failed_step[i]`` is the index of the step in which body
-    ``i`` failed, or -1; a failed body's row keeps its last good state.
+                 first_step, end_step, method, record_every):  # fmt: skip
+    """Carry bodies ``first..last-1`` through steps ``first_step..end_step-1`` of a run (the runner's loop,
+    ``tumble.runner``, owns the run): ``failed_step[i]`` is the index of the step in which body ``i`` failed, or
+    -1; a failed body's row keeps its last good state. The applied loads ``force``, ``torque`` act in the run's
+    step 0; the actuators' motors are at their speeds of step ``first_step``.
 
     The loop over the bodies is in here, and its body hands the per-body steps no array: a function compiled into a
     loop (Numba's ``inline="always"``) takes a reference to every array it is given at each pass, two atomic
@@ -106,7 +103,7 @@ def advance_rows(first, last, bodies, gravity, force, torque, acts, pos, quat, l
     for i in range(first, last):
         failed_step[i] = -1
         if not bodies.is_dynamic[i]:
-            _copy_static_rows(i, pos, quat, linvel, angmom, rec, n_steps, record_every)
+            _copy_static_rows(i, pos, quat, linvel, angmom, rec, first_step, end_step, record_every)
             continue
         # Gravity and the constant loads act in every step; applied loads in the first step only.
         weight = add_scaled(load3(bodies.constant_force, i), g, bodies.mass[i])
@@ -115,13 +112,13 @@ def advance_rows(first, last, bodies, gravity, force, torque, acts, pos, quat, l
                 load3(force, i), load3(torque, i))  # fmt: skip
         state = (load3(pos, i), load4(quat, i), load3(linvel, i), load3(angmom, i))
         turn = ((1.0, 0.0, 0.0, 0.0), (math.nan, math.nan, math.nan))  # auto's flight: exp(½ h ω), and the L of ω
-        done, failed = 0, -1
-        while done < n_steps and failed < 0:
-            end = min(done + record_every, n_steps) if record_every > 0 else n_steps
+        done, failed = first_step, -1
+        while done < end_step and failed < 0:
+            end = min((done // record_every + 1) * record_every, end_step) if record_every > 0 else end_step
             if acts.driven[i]:
-                failed, state, turn = _body_steps(i, body, state, turn, acts, h, done, end, method)
+                failed, state, turn = _body_steps(i, body, state, turn, acts, h, first_step, done, end, method)
             else:
-                failed, state, turn = _body_steps(i, body, state, turn, None, h, done, end, method)
+                failed, state, turn = _body_steps(i, body, state, turn, None, h, first_step, done, end, method)
             if failed < 0 and record_every > 0 and end % record_every == 0:
                 frame = end // record_every - 1
                 store3(rec.pos[frame], i, state[0])
@@ -137,15 +134,17 @@ def advance_rows(first, last, bodies, gravity, force, torque, acts, pos, quat, l
 
 
 @inline(into_callers=True)
-def _body_steps(i, body, state, turn, acts, h, first_step, end_step, method):
-    """Steps ``first_step..end_step-1`` of body ``i`` from ``state``, with its actuators ``acts`` or ``None``:
-    ``(failing step or -1, last good state, turn)``. ``turn`` carries auto's flight rotation ``exp(½ h ω)`` with the
-    ``L`` it was computed for, so that a flight computes it once, not at every step or recorded frame."""
+def _body_steps(i, body, state, turn, acts, h, motors_step, first_step, end_step, method):
+    """Steps ``first_step..end_step-1`` of body ``i`` from ``state``, with its actuators ``acts`` (their motors at
+    their speeds of step ``motors_step``) or ``None``: ``(failing step or -1, last good state, turn)``. ``turn``
+    carries auto's flight rotation ``exp(½ h ω)`` with the ``L`` it was computed for, so that a flight computes it
+    once, not at every step or recorded frame."""
     inv_m, inertia, inv_inertia, c_lin, c_ang, weight, steady_torque, applied_force, applied_torque = body
     x, q, v, l = state
     spin, spin_for = turn
     failed = -1
     for s in range(first_step, end_step):
+        tau = (s - motors_step) * h  # the time since the motors' speeds
         f = (weight[0] + applied_force[0], weight[1] + applied_force[1], weight[2] + applied_force[2])
         t = (steady_torque[0] + applied_torque[0], steady_torque[1] + applied_torque[1],
              steady_torque[2] + applied_torque[2])  # fmt: skip
@@ -158,17 +157,15 @@ def _body_steps(i, body, state, turn, acts, h, first_step, end_step, method):
                 spin, spin_for = spin_turn(inv_inertia, l, h), l
             xn, qn, vn, ln = flight_step(x, q, v, l, inv_m, f, spin, h)
         elif method == 0:
-            xn, qn, vn, ln = euler_step(x, q, v, l, inv_m, inertia, inv_inertia, f, t, c_lin, c_ang, h, acts, i, s * h)
+            xn, qn, vn, ln = euler_step(x, q, v, l, inv_m, inertia, inv_inertia, f, t, c_lin, c_ang, h, acts, i, tau)
         elif method == 1:
             xn, qn, vn, ln = symplectic_step(
-                x, q, v, l, inv_m, inertia, inv_inertia, f, t, c_lin, c_ang, h, acts, i, s * h
+                x, q, v, l, inv_m, inertia, inv_inertia, f, t, c_lin, c_ang, h, acts, i, tau
             )
         elif method == 2 or method == 4:
-            xn, qn, vn, ln = rk4_step(x, q, v, l, inv_m, inertia, inv_inertia, f, t, c_lin, c_ang, h, acts, i, s * h)
+            xn, qn, vn, ln = rk4_step(x, q, v, l, inv_m, inertia, inv_inertia, f, t, c_lin, c_ang, h, acts, i, tau)
         else:
-            xn, qn, vn, ln = midpoint_step(
-                x, q, v, l, inv_m, inertia, inv_inertia, f, t, c_lin, c_ang, h, acts, i, s * h
-            )
+            xn, qn, vn, ln = midpoint_step(x, q, v, l, inv_m, inertia, inv_inertia, f, t, c_lin, c_ang, h, acts, i, tau)
         if not (is_finite3(xn) and quat_is_finite(qn) and is_finite3(vn) and is_finite3(ln)):
             failed = s
             break
@@ -177,32 +174,15 @@ def _body_steps(i, body, state, turn, acts, h, first_step, end_step, method):
 
 
 @inline
-def _copy_static_rows(i, pos, quat, linvel, angmom, rec, n_steps, record_every):
-    """Static bodies do not move; their rows in every recorded frame are their current state."""
+def _copy_static_rows(i, pos, quat, linvel, angmom, rec, first_step, end_step, record_every):
+    """Static bodies do not move; their rows in every frame recorded in steps ``first_step..end_step-1`` are their
+    current state."""
     if record_every > 0:
-        for frame in range(n_steps // record_every):
+        for frame in range(first_step // record_every, end_step // record_every):
             store3(rec.pos[frame], i, load3(pos, i))
             store4(rec.quat[frame], i, load4(quat, i))
             store3(rec.linvel[frame], i, load3(linvel, i))
             store3(rec.angmom[frame], i, load3(angmom, i))
-
-
-@kernel
-def _advance_rows_kernel(bodies, gravity, force, torque, acts, pos, quat, linvel, angmom, backup, rec, failed_step,
-                         h, n_steps, method, record_every, first, last):  # fmt: skip
-    """Bodies ``first..last-1``; returns their first failing step, or -1. Releases the GIL (``nogil``).
-
-    ``backup`` receives each row before it moves; ``failed_step[i]`` the failing step of body ``i`` or -1.
-    """
-    for i in range(first, last):
-        _save_row(i, pos, quat, linvel, angmom, backup)
-    advance_rows(first, last, bodies, gravity, force, torque, acts, pos, quat, linvel, angmom, rec, failed_step, h,
-                 n_steps, method, record_every)  # fmt: skip
-    first_failure = -1
-    for i in range(first, last):
-        if failed_step[i] >= 0 and (first_failure < 0 or failed_step[i] < first_failure):
-            first_failure = failed_step[i]
-    return first_failure
 
 
 def threads() -> int:
@@ -232,7 +212,7 @@ def using_threads(count: int):
         _THREADS = before
 
 
-def _thread_pool() -> ThreadPoolExecutor:
+def thread_pool() -> ThreadPoolExecutor:
     """The pool, grown to ``_THREADS`` workers if :func:`using_threads` asked for more than it has."""
     global _POOL, _POOL_SIZE
     if _POOL_SIZE < _THREADS:
@@ -240,72 +220,3 @@ def _thread_pool() -> ThreadPoolExecutor:
             _POOL.shutdown(wait=False)
         _POOL, _POOL_SIZE = ThreadPoolExecutor(max_workers=_THREADS, thread_name_prefix="tumble"), _THREADS
     return _POOL
-
-
-def _run_rows(args: tuple, body_count: int, work: int) -> int:
-    """Advance all rows, split across threads when the work is large (rows are independent: any split gives
-    the same bits). Threads rather than ``prange`` keep one compiled kernel, which halves the cold start."""
-    if work < PARALLEL_MIN_WORK or _THREADS < 2 or body_count < 2:
-        return _advance_rows_kernel(*args, 0, body_count)
-    bounds = np.linspace(0, body_count, min(_THREADS, body_count) + 1).astype(np.int64)
-    futures = [
-        _thread_pool().submit(_advance_rows_kernel, *args, int(lo), int(hi))
-        for lo, hi in zip(bounds[:-1], bounds[1:], strict=True)
-    ]
-    failures = [f.result() for f in futures]
-    failed = [f for f in failures if f >= 0]
-    return min(failed) if failed else -1
-
-
-@inline(into_callers=True)
-def _save_row(i, pos, quat, linvel, angmom, backup):
-    store3(backup[0], i, load3(pos, i))
-    store4(backup[1], i, load4(quat, i))
-    store3(backup[2], i, load3(linvel, i))
-    store3(backup[3], i, load3(angmom, i))
-
-
-def advance_free_bodies(
-    model: Model,
-    state: State,
-    body_force: np.ndarray,
-    body_torque: np.ndarray,
-    acts,
-    scratch,
-    h: float,
-    n_steps: int,
-    method: Integrator,
-    recording: Recording | None = None,
-    record_every: int = 0,
-) -> tuple[int, int]:
-    """Integrate every dynamic body for ``n_steps`` steps of ``h``.
-
-    Reads: model.body_*, model.gravity, body_force, body_torque (applied during the first step only), the
-    actuators ``acts`` (:class:`~tumble.dynamics.actuation.ActuatorArrays`: their loads at every stage, the motors'
-    speeds at the start of the call; the caller advances the motors after it).
-    Writes: state.body_pos/quat/linvel/angmom, ``recording`` (one frame every ``record_every`` steps),
-    scratch.backup_* and scratch.failed_step.
-
-    Returns:
-        ``(steps_done, failing_body)``: ``steps_done == n_steps`` and ``failing_body == -1`` on success;
-        otherwise the state is that after ``steps_done`` steps (the last good one) and ``failing_body`` is
-        the row of the first body whose state became non-finite in the next step.
-    """
-    bodies = model.body_arrays
-    if recording is None:
-        recording, record_every = scratch.no_recording, 0
-    arrays = (state.body_pos, state.body_quat, state.body_linvel, state.body_angmom)
-    args = (bodies, model.gravity, body_force, body_torque, acts, *arrays, scratch.backup, recording,
-            scratch.failed_step, h, n_steps, int(method), record_every)  # fmt: skip
-    first_failure = _run_rows(args, model.body_count, model.body_count * n_steps)
-    if first_failure < 0:
-        return n_steps, -1
-    # Roll every body back and replay only the steps that all of them completed.
-    steps_done = int(first_failure)
-    failing_body = int(np.flatnonzero(scratch.failed_step == first_failure)[0])
-    for a, b in zip(arrays, scratch.backup, strict=True):
-        np.copyto(a, b)
-    if steps_done > 0:
-        replay = args[:-3] + (steps_done, int(method), record_every)
-        _advance_rows_kernel(*replay, 0, model.body_count)
-    return steps_done, failing_body

@@ -1,0 +1,93 @@
+"""The runner's one compiled loop (``tumble.runner``): free bodies with or without a compiled controller stage, on one
+thread or split over two, back up, restore on a non-finite value and advance the motors alike."""
+
+from __future__ import annotations
+
+import os
+
+import numpy as np
+import pytest
+
+import tumble
+from compiled import compiled_only
+from tumble import _jit, runner
+from tumble.actuators import Rotor, Thruster
+from tumble.control import native
+from tumble.dynamics import integrate
+
+K_THRUST, K_MOMENT = 8.5e-6, 1.4e-7
+
+
+def _rotors_and_a_runaway(bodies: int = 6) -> tuple[tumble.World, list]:
+    """Free bodies, the first ones each lifted by a rotor that spins up (a motor lag), the last one so fast that its
+    position overflows after about 17 steps of 1 s."""
+    world = tumble.World(gravity=(0, 0, -9.81))
+    rotors = []
+    for k in range(bodies - 1):
+        body = world.add_body(None, mass=0.1, inertia=np.eye(3) * 1e-3, position=(k, 0, 0), velocity=(0, 0, k))
+        rotor = world.add_actuator(Rotor(body, (0, 0, 0), (0, 0, 1), 1, K_THRUST, K_MOMENT, time_constant=0.05))
+        rotor.command(400.0 + 10 * k)
+        rotors.append(rotor)
+    world.add_body(None, mass=1.0, inertia=np.eye(3), velocity=(1e307, 0, 0), name="runaway")
+    return world, rotors
+
+
+def _run_until_failure(world: tumble.World, rotors: list):
+    with pytest.raises(tumble.SimulationError, match="runaway") as info:
+        world.simulate(100.0, 1.0, record_every=2)
+    trajectory = info.value.trajectory
+    return (info.value.step, world.state.digest(), [r.speed for r in rotors], trajectory.position.tobytes(),
+            trajectory.orientation.tobytes())  # fmt: skip
+
+
+@pytest.mark.skipif((os.cpu_count() or 1) < 2, reason="needs two cores")
+@compiled_only("plain Python runs the blocks one after the other")
+def test_a_failure_in_one_block_of_threads_leaves_what_one_thread_leaves(monkeypatch):
+    """The runaway body is in the second block: the first block ran all the steps, so the runner rolls every block
+    back, motors included, and replays the steps that all the bodies completed."""
+    monkeypatch.setattr(integrate, "PARALLEL_MIN_WORK", 1)
+    results = {}
+    for count in (1, 2):
+        with integrate.using_threads(count):
+            results[count] = _run_until_failure(*_rotors_and_a_runaway())
+    assert results[1] == results[2]
+    step, *_ = results[1]
+    assert 10 < step < 30
+
+
+def test_the_motors_of_a_failed_run_stop_at_the_last_good_step():
+    """A rotor's speed after the failure is the speed after the steps done: the same as a run of just those steps."""
+    world, rotors = _rotors_and_a_runaway()
+    step, digest, speeds, *_ = _run_until_failure(world, rotors)
+    again, again_rotors = _rotors_and_a_runaway()
+    again.simulate(float(step), 1.0)
+    assert again.state.digest() == digest
+    assert [r.speed for r in again_rotors] == speeds
+
+
+def test_a_step_that_fails_at_once_changes_nothing_not_even_the_motors():
+    """The world keeps its state from before the failed step: a thruster's force stays the last step's, not the new
+    command (a motor advanced by no time would take it)."""
+    world = tumble.World(gravity=(0, 0, 0))
+    body = world.add_body(None, mass=0.1, inertia=np.eye(3) * 1e-3)
+    rotor = world.add_actuator(Rotor(body, (0, 0, 0), (0, 0, 1), 1, K_THRUST, K_MOMENT, time_constant=0.05))
+    thruster = world.add_actuator(Thruster(body, (0, 0, 0), (1, 0, 0), max_force=10.0))
+    rotor.command(500.0)
+    thruster.command(2.0)
+    world.add_body(None, mass=1.0, inertia=np.eye(3), velocity=(1e308, 0, 0), name="runaway")
+    before = world.state.copy()
+    with pytest.raises(tumble.SimulationError, match="runaway"):
+        world.step(1e10)
+    assert world.state.digest() == before.digest()
+    assert rotor.speed == 0.0 and thruster.force == 0.0
+    assert rotor.commanded_speed == 500.0 and thruster.commanded_force == 2.0  # the commands wait for the next step
+
+
+@compiled_only("the cache stamps compiled code")
+def test_the_loop_with_a_compiled_stage_is_stamped_with_the_stage_package():
+    """The copy of the runner's loop that the flights' stage is bound into embeds control's kernels: an edit there
+    must invalidate it on disk, as it does control's own kernels."""
+    staged = runner._staged_steps(native.command_stage)
+    stamp = staged._cache._impl._locator.get_source_stamp()
+    assert stamp == _jit._package_stamp("control") != _jit._package_stamp(None)
+    assert runner._plain_steps._cache._impl._locator.get_source_stamp() == _jit._package_stamp(None)
