@@ -106,37 +106,43 @@ def _free_steps(stage, bodies, gravity, force, torque, acts, pos, quat, linvel, 
 
     The replay goes through the same call of ``advance_rows`` as the chunk: it is compiled into this loop, and a
     second call would compile the integrators twice (5 s more of a cold start)."""
-    done, failing_body, failing_step = 0, -1, n_steps
+    done = 0
     while done < n_steps:
         end = min(done + chunk, n_steps)
-        if failing_body >= 0:  # the replay of the steps before the failure: ``end`` is that step
-            end = failing_step
-        else:
-            t = origin_time + (origin_count + done) * h
-            failing_controller = command_stage(stage, gravity, acts, pos, quat, linvel, angmom, t, h)  # noqa: F821
-            if failing_controller >= 0:
-                return done, -1, failing_controller
+        t = origin_time + (origin_count + done) * h
+        failing_controller = command_stage(stage, gravity, acts, pos, quat, linvel, angmom, t, h)  # noqa: F821
+        if failing_controller >= 0:
+            return done, -1, failing_controller
+        for i in range(first, last):
+            _save_row(i, pos, quat, linvel, angmom, backup)
+        failing_body = -1
+        while True:  # the chunk; after a failure, once more from the backup up to the failing step
+            advance_rows(first, last, bodies, gravity, force, torque, acts, pos, quat, linvel, angmom, rec,
+                         failed_step, h, done, end, method, record_every)  # fmt: skip
+            failing_step, body = _first_failure(failed_step, first, last, end)
+            if body < 0:
+                break
+            failing_body, end = body, failing_step
             for i in range(first, last):
-                _save_row(i, pos, quat, linvel, angmom, backup)
-        advance_rows(first, last, bodies, gravity, force, torque, acts, pos, quat, linvel, angmom, rec, failed_step,
-                     h, done, end, method, record_every)  # fmt: skip
-        if failing_body < 0:
-            failing_step = end
-            for i in range(first, last):
-                if 0 <= failed_step[i] < failing_step:
-                    failing_step, failing_body = failed_step[i], i
-            if failing_body >= 0:
-                # Roll the rows back, then replay only the steps that all of them completed (if any).
-                for i in range(first, last):
-                    _restore_row(i, pos, quat, linvel, angmom, backup)
-                if failing_step > done:
-                    continue
+                _restore_row(i, pos, quat, linvel, angmom, backup)
+            if end == done:
                 return done, failing_body, -1
         advance_motors(acts, first, last, (end - done) * h)
         done = end
         if failing_body >= 0:
             return done, failing_body, -1
     return n_steps, -1, -1
+
+
+@inline
+def _first_failure(failed_step, first, last, end):
+    """``(step, row)``: the earliest step in which a row of ``first..last-1`` failed and the first such row, or
+    ``(end, -1)``."""
+    step, row = end, -1
+    for i in range(first, last):
+        if 0 <= failed_step[i] < step:
+            step, row = failed_step[i], i
+    return step, row
 
 
 @inline

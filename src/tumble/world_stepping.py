@@ -142,9 +142,7 @@ def _simulate_stage(world, stage, dt: float, n_steps: int, recording, record_eve
                                recording, record_every, _actuators_for_step(world, dt), stage, clock)  # fmt: skip
         error = None
         if steps.failing_controller >= 0:  # before the step ``steps.done``, at its counted start time
-            origin_time, origin_count = clock
-            t = origin_time + (origin_count + steps.done) * dt
-            error = stage.failure(steps.failing_controller, t, state.step_count)
+            error = stage.failure(steps.failing_controller, _next_step_time(world, dt), state.step_count)
         result = steps.done, steps.failing_body, error
     stage.finish()
     return result

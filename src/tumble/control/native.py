@@ -173,8 +173,10 @@ class NativeFlights:
 
     def __init__(self, controllers: list, table: FlightTable):
         self._controllers, self._table = controllers, table
-        self._speeds = np.zeros(4)  # what the last flight that ran asked for
-        self.compiled_data = (table, np.zeros((5, 3)), self._speeds, np.zeros(3))
+        # command_flights' scratch: the reference's derivatives, the rotor speeds asked for (read by failure()),
+        # the integral term
+        self._ref, self._speeds, self._integral = np.zeros((5, 3)), np.zeros(4), np.zeros(3)
+        self.compiled_data = (table, self._ref, self._speeds, self._integral)
 
     @classmethod
     def for_world(cls, world, controllers) -> NativeFlights | None:
@@ -186,7 +188,7 @@ class NativeFlights:
 
     def command(self, model, state, acts, t: float, dt: float) -> None:
         failing = command_flights(self._table, model.gravity, acts, state.body_pos, state.body_quat, state.body_linvel,
-                                  state.body_angmom, t, dt, *self.compiled_data[1:])  # fmt: skip
+                                  state.body_angmom, t, dt, self._ref, self._speeds, self._integral)  # fmt: skip
         if failing >= 0:
             raise self.failure(failing, t, state.step_count)
 
