@@ -5,12 +5,16 @@ Free bodies (nothing can touch) take all the steps of a call at once, body by bo
 
     advance_rows          model.body_*, inputs  -> state.body_*            (dynamics/integrate.py)
 
-Bodies with contacts (the soft step of DESIGN.md):
+Bodies with contacts (the soft step of DESIGN.md), all of it one compiled call (``_step_kernel``): a step enters
+compiled code once, and the runner's compiled loop can take the stages as they are. The narrow phase's loop of every
+pair type is compiled in (one copy for every world, cached on disk; the loops of pair types a world lacks never run):
 
     to_angular_velocity   state.body_angmom      -> scratch.body_angvel, body_inv_inertia_world (dynamics/substep.py)
     update_aabbs          state, geometry        -> world bounds           (geometry/broad_phase.py)
-    find_pairs            bounds, filters        -> candidate pairs        (geometry/broad_phase.py)
-    collide_pairs         pairs                  -> scratch.manifolds      (geometry/narrow_phase.py)
+    sweep_and_prune       bounds, filters        -> candidate pairs        (geometry/broad_phase.py); more than
+                          the buffers hold: the call returns before anything but scratch changed, and runs again
+    collide_each          pairs                  -> scratch.manifolds      (geometry/narrow_phase.py)
+    keep_touching         manifolds              -> those with points      (geometry/narrow_phase.py)
     match_warm_start      state.contact_*        -> scratch.warm_*         (geometry/narrow_phase.py)
     wake_touched          manifolds              -> state.body_sleeping    (dynamics/islands.py)
     prepare_contacts      manifolds, bodies      -> scratch.rows           (dynamics/contact_solver.py)
@@ -22,7 +26,7 @@ Bodies with contacts (the soft step of DESIGN.md):
       rebase_contacts     fresh manifolds        -> their manifolds, rows  (dynamics/contact_solver.py)
     apply_restitution     rows                   -> velocities             (dynamics/contact_solver.py)
     limit_to_impact       pairs, poses           -> poses of fast bodies   (geometry/toi.py)
-    store impulses        rows                   -> state.contact_*        (here)
+    store_impulses        rows                   -> scratch.stored, then state.contact_* (dynamics/contact_solver.py)
     update_sleep          manifolds, velocities  -> state.body_sleep_*     (dynamics/islands.py)
     to_angular_momentum   scratch.body_angvel    -> state.body_angmom      (dynamics/substep.py)
 
@@ -34,239 +38,132 @@ from __future__ import annotations
 
 import numpy as np
 
-from .dynamics.actuation import ActuatorArrays
-from .dynamics.contact_solver import apply_restitution, prepare_contacts, rebase_contacts
+from ._jit import inline
+from .dynamics.contact_solver import apply_restitution, prepare_contacts, rebase_contacts, store_impulses
 from .dynamics.islands import update_sleep, wake_touched
 from .dynamics.substep import run_substeps, to_angular_momentum, to_angular_velocity
-from .geometry.broad_phase import find_pairs, update_aabbs
-from .geometry.narrow_phase import allocate_manifolds, collide_each, collide_pairs, contact_passes, match_warm_start
+from .geometry.broad_phase import pair_filters, sweep_and_prune, update_aabbs
+from .geometry.narrow_phase import (
+    COLLIDER_OF,
+    compiled_collide_each,
+    contact_passes,
+    keep_touching,
+    match_warm_start,
+    passes_due,
+)
 from .geometry.toi import limit_to_impact
-from .inputs import Inputs
 from .model import Model
-from .params import Params
 from .scratch import Scratch
 from .state import State
 
-__all__ = ["contact_step"]
+__all__ = ["body_state", "buffers", "contact_stages", "model_rows"]
 
 
-def contact_step(
-    model: Model, state: State, inputs: Inputs, params: Params, scratch: Scratch, dt: float, acts: ActuatorArrays
-) -> None:
-    """One soft step of ``dt`` (see the module docstring for the stages)."""
-    settings = params.solver
-    substeps = settings.substeps_for(dt)
+def model_rows(model: Model) -> tuple:
+    """The model's arrays as :func:`contact_stages` reads them."""
+    shape_rows = (model.shape_friction, model.shape_restitution, model.shape_rolling, model.shape_core_radius)
+    filters = pair_filters(model.shape_count, model.shape_group, model.shape_mask, model.joint_exclusions)
+    return (model.body_arrays, model.geometry, model.body_gravity, model.body_free_to_sweep, shape_rows, filters,
+            model.copy_shape_count, model.joints, COLLIDER_OF)  # fmt: skip
+
+
+def body_state(state: State) -> tuple:
+    """The state's per-body arrays as :func:`contact_stages` reads and writes them (in place)."""
+    return (state.body_pos, state.body_quat, state.body_linvel, state.body_angmom, state.body_sleep_time,
+            state.body_sleeping, state.body_island)  # fmt: skip
+
+
+def buffers(scratch: Scratch) -> tuple:
+    """The scratch arrays :func:`contact_stages` works in (to take again after ``scratch.reserve_contacts``)."""
+    return (scratch.pairs.a, scratch.pairs.b, scratch.manifolds, scratch.fresh, scratch.rows, scratch.warm_normal,
+            scratch.warm_tangent, scratch.stored, scratch.body_angvel, scratch.body_inv_inertia_world, scratch.aabb_lo,
+            scratch.aabb_hi, scratch.joint_force_total, scratch.joint_moment_total, scratch.island_parent,
+            scratch.island_min_time)  # fmt: skip
+
+
+@inline(into_callers=True)
+def contact_stages(model_rows, body_state, contact_state, joint_impulses, loads, buffers, settings, dt, substeps):
+    """One soft step of ``dt`` in ``substeps``: the stages of the module docstring in order, over the groups of
+    arrays that :func:`model_rows`, :func:`body_state` and :func:`buffers` give (``loads``: applied force, torque
+    and the actuators). ``contact_state`` is the last step's ``State.contact_*`` arrays, read before this step's
+    impulses go to ``scratch.stored`` (they may be its rows). Returns ``(manifolds, most passes)``, or
+    ``(-candidate pairs, 0)`` when the pair and contact buffers hold fewer (then nothing but scratch has changed:
+    grow them and step again). Inlined into the runner's compiled loop, its one caller (a kernel of its own would be
+    optimised twice, once alone and once in the loop: a minute of a cold start)."""
+    bodies, geom, gravity, free_to_sweep, shape_rows, filters, segment_size, joints, collider_of = model_rows
+    pos, quat, linvel, angmom, sleep_time, sleeping, island = body_state
+    force, torque, acts = loads
+    (pairs_a, pairs_b, manifolds, fresh, rows, warm_normal, warm_tangent, stored, angvel, inv_inertia_world, aabb_lo,
+     aabb_hi, joint_force_total, joint_moment_total, island_parent, island_min_time) = buffers  # fmt: skip
     h = dt / substeps
-    bodies, geom = model.body_arrays, model.geometry
-    angvel, inv_inertia_world = scratch.body_angvel, scratch.body_inv_inertia_world
+    margin = settings.speculative_distance
     # Angular velocities and world inverse inertias at the start of the step.
-    to_angular_velocity(bodies, state.body_quat, state.body_angmom, angvel, inv_inertia_world)
+    to_angular_velocity(bodies, quat, angmom, angvel, inv_inertia_world)
     # Broad phase: bounds swept over the step, candidate pairs.
-    update_aabbs(
-        geom,
-        state.body_pos,
-        state.body_quat,
-        state.body_linvel,
-        settings.speculative_distance,
-        dt,
-        scratch.aabb_lo,
-        scratch.aabb_hi,
-    )
-    pairs_a, pairs_b = find_pairs(
-        geom,
-        state.body_pos,
-        state.body_quat,
-        scratch.aabb_lo,
-        scratch.aabb_hi,
-        model.body_is_dynamic,
-        shape_group=model.shape_group,
-        shape_mask=model.shape_mask,
-        excluded_body_pairs=model.joint_exclusions,
-        margin=settings.speculative_distance,
-        buffer=scratch.pairs,
-        segment_size=model.copy_shape_count,
-    )
+    update_aabbs(geom, pos, quat, linvel, margin, dt, aabb_lo, aabb_hi)
+    group, mask, excluded = filters
+    pair_count = sweep_and_prune(geom, pos, quat, aabb_lo, aabb_hi, bodies.is_dynamic, group, mask, excluded, margin,
+                                 segment_size, pairs_a, pairs_b)  # fmt: skip
+    if pair_count > pairs_a.shape[0] or pair_count > manifolds.shape_a.shape[0]:
+        return -pair_count, 0
+    pairs_a, pairs_b = pairs_a[:pair_count], pairs_b[:pair_count]
     # Narrow phase: manifolds, and the impulses of the same points last step.
-    scratch.reserve_contacts(pairs_a.shape[0])
-    manifolds = scratch.manifolds
-    count = collide_pairs(
-        geom,
-        state.body_pos,
-        state.body_quat,
-        state.body_linvel,
-        angvel,
-        pairs_a,
-        pairs_b,
-        settings.speculative_distance,
-        dt,
-        manifolds,
-    )
-    match_warm_start(
-        manifolds,
-        count,
-        state.contact_shape_a,
-        state.contact_shape_b,
-        state.contact_point_count,
-        state.contact_feature,
-        state.contact_normal_impulse,
-        state.contact_tangent_impulse,
-        scratch.warm_normal,
-        scratch.warm_tangent,
-    )
+    compiled_collide_each(geom, pos, quat, linvel, angvel, pairs_a, pairs_b, margin, dt, manifolds, collider_of)
+    count = keep_touching(manifolds, pair_count)
+    match_warm_start(manifolds, count, *contact_state, warm_normal, warm_tangent)
     # Sleeping islands that an awake body touches wake up; bodies that do not move count as fixed.
-    if settings.sleep and state.body_sleeping.any():
-        wake_touched(
-            model.body_is_dynamic,
-            geom.shape_body,
-            manifolds,
-            count,
-            model.joints.body_a,
-            model.joints.body_b,
-            state.body_sleep_time,
-            state.body_sleeping,
-            state.body_island,
-        )
-    moving = model.body_is_dynamic & ~state.body_sleeping
+    if settings.sleep and sleeping.any():
+        wake_touched(bodies.is_dynamic, geom.shape_body, manifolds, count, joints.body_a, joints.body_b, sleep_time,
+                     sleeping, island)  # fmt: skip
+    moving = bodies.is_dynamic & ~sleeping
     inv_mass = np.where(moving, bodies.inv_mass, 0.0)
-    inv_inertia_world[~moving] = 0.0
+    for i in range(moving.shape[0]):
+        if not moving[i]:
+            inv_inertia_world[i] = 0.0
     # Solver: prepare once, then the substeps, then restitution.
-    rows = scratch.rows
-    prepare_contacts(
-        manifolds,
-        count,
-        geom.shape_body,
-        model.shape_friction,
-        model.shape_restitution,
-        model.shape_rolling,
-        model.shape_core_radius,
-        inv_mass,
-        inv_inertia_world,
-        state.body_pos,
-        state.body_linvel,
-        angvel,
-        scratch.warm_normal,
-        scratch.warm_tangent,
-        settings.contact_hertz,
-        settings.contact_damping_ratio,
-        h,
-        rows,
-    )
-    pos0, quat0 = state.body_pos.copy(), state.body_quat.copy()
-    scratch.joint_force_total[:] = 0.0
-    scratch.joint_moment_total[:] = 0.0
-    scratch.joint_step = dt
-
-    def substeps_between(first: int, last: int) -> None:
-        run_substeps(
-            bodies,
-            moving,
-            inv_mass,
-            model.body_gravity,
-            inputs.body_force,
-            inputs.body_torque,
-            acts,
-            rows,
-            count,
-            inv_inertia_world,
-            state.body_pos,
-            state.body_quat,
-            pos0,
-            quat0,
-            state.body_linvel,
-            angvel,
-            h,
-            first,
-            last,
-            settings.contact_push_max,
-            settings.restitution_threshold,
-            model.joints if model.joint_count > 0 else None,  # None: no joint solver compiled or run
-            state.joint_impulses,
-            settings.joint_hertz,
-            settings.joint_damping_ratio,
-            scratch.joint_force_total,
-            scratch.joint_moment_total,
-        )
-
+    friction, restitution, rolling, core_radius = shape_rows
+    prepare_contacts(manifolds, count, geom.shape_body, friction, restitution, rolling, core_radius, inv_mass,
+                     inv_inertia_world, pos, linvel, angvel, warm_normal, warm_tangent, settings.contact_hertz,
+                     settings.contact_damping_ratio, h, rows)  # fmt: skip
+    pos0, quat0 = pos.copy(), quat.copy()
+    joint_force_total[:] = 0.0
+    joint_moment_total[:] = 0.0
+    substeps_args = (bodies, moving, inv_mass, gravity, force, torque, acts, rows, count, inv_inertia_world, pos,
+                     quat, pos0, quat0, linvel, angvel, h)  # fmt: skip
+    solver_args = (settings.contact_push_max, settings.restitution_threshold, joints, joint_impulses,
+                   settings.joint_hertz, settings.joint_damping_ratio, joint_force_total,
+                   joint_moment_total)  # fmt: skip
     # Fast pairs, and the other pairs of their moving bodies, find their contacts again within the step
     # (contact_passes); by the motion of their own bodies only, so a batch's copies step as separate worlds would.
-    passes = np.empty(count, dtype=np.int64)
-    if substeps > 1 and contact_passes(geom.shape_body, geom.shape_aabb_center_local, geom.shape_aabb_half_local,
-                                       moving, manifolds.shape_a, manifolds.shape_b, count, state.body_linvel, angvel,
-                                       dt, passes) > 1:  # fmt: skip
-        first = 0
-        for last, listed in _pass_boundaries(passes, substeps):
-            substeps_between(first, last)
-            _find_again(model, state, settings, scratch, listed, (substeps - last) * h, inv_mass, pos0, quat0)
-            first = last
-        substeps_between(first, substeps)
-    else:
-        substeps_between(0, substeps)
-    apply_restitution(rows, count, inv_mass, inv_inertia_world, state.body_pos, state.body_quat, pos0, quat0,
-                      state.body_linvel, angvel, settings.restitution_threshold)  # fmt: skip
+    passes = np.empty(count, np.int64)
+    first, most = 0, 1
+    if substeps > 1:
+        most = contact_passes(geom.shape_body, geom.shape_aabb_center_local, geom.shape_aabb_half_local, moving,
+                              manifolds.shape_a, manifolds.shape_b, count, linvel, angvel, dt, passes)  # fmt: skip
+    if most > 1:
+        listed = np.empty(count, np.int64)
+        for k in range(1, substeps):
+            due = passes_due(passes, count, k, substeps, listed)
+            if due == 0:
+                continue
+            run_substeps(*substeps_args, first, k, *solver_args)
+            # The listed manifolds' contacts found again at the poses now; the margin looks ahead to the step's end.
+            again = listed[:due]
+            compiled_collide_each(geom, pos, quat, linvel, angvel, manifolds.shape_a[again], manifolds.shape_b[again],
+                                  margin, (substeps - k) * h, fresh, collider_of)  # fmt: skip
+            rebase_contacts(again, fresh, manifolds, rows, inv_mass, inv_inertia_world, pos, quat, pos0, quat0,
+                            linvel, angvel)  # fmt: skip
+            first = k
+    run_substeps(*substeps_args, first, substeps, *solver_args)
+    apply_restitution(rows, count, inv_mass, inv_inertia_world, pos, quat, pos0, quat0, linvel, angvel,
+                      settings.restitution_threshold)  # fmt: skip
     # Fast bodies that would have passed into static geometry stop at their first touch (unless jointed).
-    limit_to_impact(geom, model.body_is_dynamic, pairs_a, pairs_b, pos0, quat0, state.body_pos, state.body_quat,
-                    model.body_free_to_sweep)  # fmt: skip
-    _store_impulses(state, manifolds, rows, count)
-    scratch.contact_count = count
+    limit_to_impact(geom, bodies.is_dynamic, pairs_a, pairs_b, pos0, quat0, pos, quat, free_to_sweep)
+    store_impulses(manifolds, rows, count, *stored)
     # Islands whose bodies have all been still long enough go to sleep.
     if settings.sleep:
-        update_sleep(
-            model.body_is_dynamic,
-            geom.shape_body,
-            manifolds,
-            count,
-            model.joints.body_a,
-            model.joints.body_b,
-            state.body_linvel,
-            angvel,
-            dt,
-            settings.sleep_linear,
-            settings.sleep_angular,
-            settings.time_to_sleep,
-            state.body_sleep_time,
-            state.body_sleeping,
-            state.body_island,
-            scratch.island_parent,
-            scratch.island_min_time,
-        )
-    to_angular_momentum(bodies, state.body_quat, angvel, state.body_angmom)
-
-
-def _pass_boundaries(passes: np.ndarray, substeps: int):
-    """``(k, rows)``: before substep ``k``, the rows whose contacts are found again, ``passes[m]`` equal runs of the
-    substeps for row ``m`` (as equal as whole substeps allow)."""
-    k = np.arange(1, substeps)
-    starts = (k * passes[:, None]) // substeps > ((k - 1) * passes[:, None]) // substeps
-    for column in np.flatnonzero(starts.any(axis=0)):
-        yield int(k[column]), np.flatnonzero(starts[:, column])
-
-
-def _find_again(model, state, settings, scratch, listed, remaining, inv_mass, pos0, quat0) -> None:
-    """The contacts of manifolds ``listed`` found again at the poses now, into their rows (``remaining``: the time
-    left in the step, which the speculative margin looks ahead)."""
-    manifolds, angvel = scratch.manifolds, scratch.body_angvel
-    fresh = allocate_manifolds(listed.shape[0])
-    collide_each(model.geometry, state.body_pos, state.body_quat, state.body_linvel, angvel,
-                 manifolds.shape_a[listed], manifolds.shape_b[listed], settings.speculative_distance, remaining,
-                 fresh)  # fmt: skip
-    rebase_contacts(listed, fresh, manifolds, scratch.rows, inv_mass, scratch.body_inv_inertia_world, state.body_pos,
-                    state.body_quat, pos0, quat0, state.body_linvel, angvel)  # fmt: skip
-
-
-def _store_impulses(state: State, manifolds, rows, count: int) -> None:
-    """Keep this step's impulses, keyed by shape pair and feature, to warm-start the next step."""
-    state.contact_shape_a = manifolds.shape_a[:count].copy()
-    state.contact_shape_b = manifolds.shape_b[:count].copy()
-    state.contact_point_count = manifolds.point_count[:count].copy()
-    state.contact_feature = manifolds.feature[:count].copy()
-    state.contact_normal_impulse = rows.normal_impulse[:count].copy()
-    state.contact_tangent_impulse = (
-        rows.tangent_impulse[:count, :, 0, None] * rows.tangent1[:count, None, :]
-        + rows.tangent_impulse[:count, :, 1, None] * rows.tangent2[:count, None, :]
-    )
-    # Slots past each manifold's point count hold leftovers of earlier steps: zero them, so that the state (and
-    # its digest) holds only what the next step reads.
-    unused = np.arange(state.contact_feature.shape[1])[None, :] >= state.contact_point_count[:, None]
-    state.contact_feature[unused] = 0
-    state.contact_normal_impulse[unused] = 0.0
-    state.contact_tangent_impulse[unused] = 0.0
+        update_sleep(bodies.is_dynamic, geom.shape_body, manifolds, count, joints.body_a, joints.body_b, linvel, angvel,
+                     dt, settings.sleep_linear, settings.sleep_angular, settings.time_to_sleep, sleep_time, sleeping,
+                     island, island_parent, island_min_time)  # fmt: skip
+    to_angular_momentum(bodies, quat, angvel, angmom)
+    return count, most

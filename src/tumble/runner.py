@@ -3,25 +3,30 @@ recorded every ``record_every`` steps, the clock and the motors advanced. ``Worl
 (``world_stepping.py``), ``Batch`` and the compiled stages of controllers all come here.
 
     simulate_steps   the one entry: free bodies take every step in one compiled loop (:func:`_free_steps`);
-                     a world whose shapes can touch or whose bodies are jointed takes one pipeline.contact_step a
-                     step in the Python loop (:func:`_contact_steps`)
+                     a world whose shapes can touch or whose bodies are jointed takes every step in the other
+                     (:func:`_contact_loop`, one pipeline.contact_stages a step)
     _free_steps      the compiled loop: before each chunk of steps a compiled controller stage (if any) commands the
                      actuators; the bodies are backed up, carried through the chunk (dynamics/integrate.py), restored
                      and replayed to the last good step on a non-finite value; the motors advance. Without a stage the
                      chunk is the whole run (body-major, split over threads when large); with one, a step
-    step_by_step     the Python loop: one step a call, a frame recorded after it; the contact steps, and a world's
-                     Python controllers and sensors (world_stepping.py), run in it
+    _contact_loop    the compiled loop of soft steps: each backed up, restored on a non-finite value (the body that
+                     failed found as the Python loop did), the motors advanced, a frame recorded; it returns early
+                     when the contact buffers must grow, and the caller grows them and calls it again
+    step_by_step     the Python loop: one step a call, a frame recorded after it; a world's Python controllers and
+                     sensors (world_stepping.py) run in it
     advance_clock    time accumulated step by step (n steps in one call = n calls of one step, bit for bit)
 """
 
 from __future__ import annotations
 
 import functools
+import math
 from typing import NamedTuple
 
 import numpy as np
 
-from ._jit import inline, kernel_for
+from . import pipeline
+from ._jit import inline, kernel, kernel_for
 from .dynamics import integrate
 from .dynamics.actuation import ActuatorArrays, advance_motors
 from .dynamics.integrate import Recording, advance_rows
@@ -29,9 +34,8 @@ from .inputs import Inputs
 from .math3d import load3, load4, store3, store4
 from .model import Model
 from .params import Integrator, Params
-from .pipeline import contact_step
 from .scratch import Scratch
-from .state import State
+from .state import CONTACT_FIELDS, State
 
 __all__ = ["Steps", "advance_clock", "record_frame", "simulate_steps", "step_by_step"]
 
@@ -213,8 +217,8 @@ def _free_body_steps(model, state, inputs, acts, scratch, h, n_steps, method, re
 
 def step_by_step(n_steps: int, one_step, recording: Recording, record_every: int, state: State) -> Steps:
     """The Python loop of steps: ``one_step(step)`` (the failing body's row, or -1; it backs up and restores its own
-    arrays), then the frame of ``state`` when one is due; stops at the first failure. The contact steps run in it,
-    and ``world_stepping`` runs a world's Python controllers and sensors in it."""
+    arrays), then the frame of ``state`` when one is due; stops at the first failure. ``world_stepping`` runs a
+    world's Python controllers and sensors in it."""
     for step in range(n_steps):
         failing = one_step(step)
         if failing >= 0:
@@ -224,55 +228,162 @@ def step_by_step(n_steps: int, one_step, recording: Recording, record_every: int
 
 
 def _contact_steps(model, state, inputs, params, scratch, h, n_steps, recording, record_every, acts):
-    """Soft steps one after the other; on a non-finite value, restore the state before that step."""
+    """Soft steps in the compiled loop (:func:`_contact_loop`); on a non-finite value the state before that step."""
     if params.resolve_integrator(True) != Integrator.SYMPLECTIC:
         raise ValueError(
             f"integrator={params.integrator!r} integrates free bodies only; a world whose shapes can touch or whose "
             "bodies are jointed steps with the contact and joint solver: use integrator='auto' or 'symplectic'"
         )
-    zero = Inputs.zeros(model.body_count)
-
-    def one_step(step: int) -> int:
-        before = state.copy()
-        loads = inputs if step == 0 else zero  # applied loads act during the first step only
+    substeps = params.solver.substeps_for(h)
+    if recording is None:
+        recording, record_every = scratch.no_recording, 0
+    # The last step's contacts into the rows the loop reads and writes.
+    count = state.contact_count
+    scratch.reserve_contacts(count)
+    for name, stored in zip(CONTACT_FIELDS, scratch.stored, strict=True):
+        stored[:count] = getattr(state, name)
+    rows, bodies = pipeline.model_rows(model), pipeline.body_state(state)
+    loads = (inputs.body_force, inputs.body_torque, acts)
+    idle = (np.zeros_like(inputs.body_force), np.zeros_like(inputs.body_torque), acts)
+    backup = _loop_backup(bodies, scratch.stored, state.joint_impulses)
+    progress = np.zeros(3, np.int64)
+    done, failing = 0, -1
+    while done < n_steps and failing < 0:
         try:
-            contact_step(model, state, loads, params, scratch, h, acts)
-            bad = _first_non_finite_body(state, model.body_is_dynamic, before)
+            done, failing, count, needed = _contact_loop(
+                rows, bodies, count, state.joint_impulses, loads, idle, pipeline.buffers(scratch), backup, progress,
+                recording, record_every, params.solver, h, substeps, done, n_steps,
+            )  # fmt: skip
         except (ZeroDivisionError, FloatingPointError):  # a kernel divided by an overflowed value
-            bad = _fastest_body(before, model.body_is_dynamic)
-        if bad >= 0:
-            state.assign(before)
-            return bad
-        advance_clock(state, h, 1)
-        if acts.speed.shape[0]:  # nothing to enter the kernel for without rotors (5 µs a step)
-            advance_motors(acts, 0, model.body_count, h)
-        return -1
+            done, count = int(progress[0]), int(progress[1])
+            _restore(bodies, scratch.stored, count, state.joint_impulses, backup)
+            failing = _fastest_body(backup, model.body_is_dynamic)
+        else:
+            if needed > 0:  # more candidate pairs than the buffers hold: grow them, keeping the contact rows
+                scratch.reserve_contacts(needed, keep=count)
+                backup = _loop_backup(bodies, scratch.stored, state.joint_impulses)
+        if done > 0:
+            scratch.joint_step = h
+    scratch.contact_count = count
+    scratch.steps_found_again += int(progress[2])
+    for name, stored in zip(CONTACT_FIELDS, scratch.stored, strict=True):
+        setattr(state, name, stored[:count].copy())
+    advance_clock(state, h, done)
+    return Steps(done, failing)
 
-    return step_by_step(n_steps, one_step, recording, record_every, state)
+
+def _loop_backup(bodies, stored, joint_impulses):
+    """Room for the state before a step: the body arrays, the contact rows, the joints' impulses."""
+    return (tuple(np.empty_like(a) for a in bodies), tuple(np.empty_like(a) for a in stored),
+            tuple(np.empty_like(a) for a in joint_impulses))  # fmt: skip
 
 
-def _first_non_finite_body(state: State, is_dynamic: np.ndarray, before: State | None = None) -> int:
+@kernel
+def _contact_loop(model_rows, body_state, count, joint_impulses, loads, idle, buffers, backup, progress, rec,
+                  record_every, settings, h, substeps, first, n_steps):  # fmt: skip
+    """Steps ``first..n_steps-1`` of a call, each one ``pipeline.contact_stages``: the state backed up before it and
+    restored on a non-finite value, the motors advanced, a frame recorded when one is due. The applied loads
+    (``loads``) act in step 0 of the call, ``idle`` (none) in the others. The contact state is the first ``count``
+    rows of ``buffers``' stored arrays; each step reads them and stores its own there.
+
+    Returns ``(steps_done, failing_body, count, pairs_needed)``: ``pairs_needed`` > 0 when the pair and contact
+    buffers must grow before step ``steps_done`` (nothing of it has run). ``progress`` holds the step running and its
+    contact count, for the caller to restore from ``backup`` when a kernel raises, and counts the steps in which some
+    contacts were found again (``Scratch.steps_found_again``)."""
+    bodies, acts, stored = model_rows[0], loads[2], buffers[7]
+    for step in range(first, n_steps):
+        progress[0], progress[1] = step, count
+        _copy_state(body_state, stored, count, joint_impulses, backup[0], backup[1], backup[2])
+        contact_state = (stored[0][:count], stored[1][:count], stored[2][:count], stored[3][:count],
+                         stored[4][:count], stored[5][:count])  # fmt: skip
+        step_loads = loads if step == 0 else idle
+        new_count, most = pipeline.contact_stages(model_rows, body_state, contact_state, joint_impulses, step_loads,
+                                                  buffers, settings, h, substeps)  # fmt: skip
+        if new_count < 0:
+            return step, -1, count, -new_count
+        failing = _first_non_finite_body(body_state, bodies.is_dynamic, backup[0])
+        if failing >= 0:
+            _copy_state(backup[0], backup[1], count, backup[2], body_state, stored, joint_impulses)
+            return step, failing, count, 0
+        count = new_count
+        progress[2] += most > 1
+        advance_motors(acts, 0, bodies.mass.shape[0], h)
+        if record_every > 0 and (step + 1) % record_every == 0:
+            frame = (step + 1) // record_every - 1
+            rec.pos[frame][:] = body_state[0]
+            rec.quat[frame][:] = body_state[1]
+            rec.linvel[frame][:] = body_state[2]
+            rec.angmom[frame][:] = body_state[3]
+    return n_steps, -1, count, 0
+
+
+@inline
+def _copy_state(body_state, stored, count, joint_impulses, to_bodies, to_stored, to_joints):
+    """The body arrays, the first ``count`` contact rows and the joints' impulses into the ``to_*`` arrays: element by
+    element of the tuples, whose arrays differ in type (no loop can index them)."""
+    to_bodies[0][:] = body_state[0]
+    to_bodies[1][:] = body_state[1]
+    to_bodies[2][:] = body_state[2]
+    to_bodies[3][:] = body_state[3]
+    to_bodies[4][:] = body_state[4]
+    to_bodies[5][:] = body_state[5]
+    to_bodies[6][:] = body_state[6]
+    to_stored[0][:count] = stored[0][:count]
+    to_stored[1][:count] = stored[1][:count]
+    to_stored[2][:count] = stored[2][:count]
+    to_stored[3][:count] = stored[3][:count]
+    to_stored[4][:count] = stored[4][:count]
+    to_stored[5][:count] = stored[5][:count]
+    to_joints[0][:] = joint_impulses[0]
+    to_joints[1][:] = joint_impulses[1]
+    to_joints[2][:] = joint_impulses[2]
+
+
+@inline
+def _first_non_finite_body(body_state, is_dynamic, before):
     """The body with a non-finite value, dynamic bodies first (a static one only turns NaN through them); when
-    several turned non-finite in the same step (one hit the other), the one that was fastest before it."""
-    finite = np.isfinite(state.body_pos).all(axis=1) & np.isfinite(state.body_quat).all(axis=1)
-    finite &= np.isfinite(state.body_linvel).all(axis=1) & np.isfinite(state.body_angmom).all(axis=1)
-    bad = np.flatnonzero(~finite & is_dynamic)
-    if bad.size == 0:
-        bad = np.flatnonzero(~finite)
-    if bad.size > 1 and before is not None:
-        return int(bad[np.argmax(_motion(before)[bad])])
-    return int(bad[0]) if bad.size else -1
+    several turned non-finite in the same step (one hit the other), the one that was fastest before it (first of
+    equals); -1 for none."""
+    pos, quat, linvel, angmom = body_state[0], body_state[1], body_state[2], body_state[3]
+    found, found_dynamic, best, best_motion = -1, False, -1, -1.0
+    for i in range(pos.shape[0]):
+        finite = np.isfinite(pos[i]).all() and np.isfinite(quat[i]).all()
+        if finite and np.isfinite(linvel[i]).all() and np.isfinite(angmom[i]).all():
+            continue
+        if found_dynamic and not is_dynamic[i]:
+            continue
+        if is_dynamic[i] and not found_dynamic:  # the first dynamic one outranks the static ones found before
+            found, found_dynamic, best, best_motion = -1, True, -1, -1.0
+        motion = _motion(before[2], before[3], i)
+        if found < 0:
+            found = i
+        if motion > best_motion:
+            best, best_motion = i, motion
+    return best if found >= 0 else -1
 
 
-def _motion(state: State) -> np.ndarray:
-    """|v| + |L| per body (non-finite counts as infinite): a rough measure of which body runs away."""
+@inline
+def _motion(linvel, angmom, i):
+    """|v| + |L| of body ``i`` (non-finite counts as infinite): a rough measure of which body runs away."""
+    v, l = load3(linvel, i), load3(angmom, i)
+    size = math.sqrt((v[0] * v[0] + v[1] * v[1]) + v[2] * v[2]) + math.sqrt((l[0] * l[0] + l[1] * l[1]) + l[2] * l[2])
+    return size if math.isfinite(size) else math.inf
+
+
+def _restore(bodies, stored, count, joint_impulses, backup):
+    for array, saved in zip(bodies, backup[0], strict=True):
+        np.copyto(array, saved)
+    for array, saved in zip(stored, backup[1], strict=True):
+        array[:count] = saved[:count]
+    for array, saved in zip(joint_impulses, backup[2], strict=True):
+        np.copyto(array, saved)
+
+
+def _fastest_body(backup, is_dynamic: np.ndarray) -> int:
+    """The dynamic body that moved fastest before the step (|v| + |L|), or -1 without one."""
     with np.errstate(over="ignore", invalid="ignore"):
-        size = np.linalg.norm(state.body_linvel, axis=1) + np.linalg.norm(state.body_angmom, axis=1)
-    return np.where(np.isfinite(size), size, np.inf)
-
-
-def _fastest_body(state: State, is_dynamic: np.ndarray) -> int:
-    motion = np.where(is_dynamic, _motion(state), -1.0)
+        size = np.linalg.norm(backup[0][2], axis=1) + np.linalg.norm(backup[0][3], axis=1)
+    motion = np.where(is_dynamic, np.where(np.isfinite(size), size, np.inf), -1.0)
     return int(np.argmax(motion)) if motion.size else -1
 
 

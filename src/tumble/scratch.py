@@ -26,7 +26,12 @@ class Scratch:
         body_angvel: (body_count, 3) ω during a contact step [rad/s], world frame.
         body_inv_inertia_world: (body_count, 3, 3) ``R I⁻¹ Rᵀ`` at the start of the contact step.
         manifolds, rows, warm_normal, warm_tangent: contact buffers, grown as needed.
+        fresh: manifolds found again within a step (as many rows as ``manifolds``).
+        stored: the contact state's arrays (``State.contact_*``, in that order) with as many rows as ``manifolds``:
+            the step writes its impulses here, and the state keeps the rows in use.
         contact_count: manifolds in use after the last contact step (``World.contacts`` reads them).
+        steps_found_again: the contact steps in which some pairs found their contacts again within the step (fast
+            pairs, ``narrow_phase.contact_passes``): a count for diagnosis and tests.
         aabb_lo, aabb_hi: (shape_count, 3) world bounds of the shapes; pairs: the broad phase's output buffer.
         island_parent, island_min_time: (body_count,) union-find work arrays of the sleep pass.
         joint_force_total, joint_moment_total: (joint_count, 3) linear and angular impulses each joint gave its
@@ -45,7 +50,10 @@ class Scratch:
     rows: ContactRows = field(default_factory=lambda: ContactRows.allocate(1))
     warm_normal: np.ndarray = field(default_factory=lambda: np.zeros((1, MAX_POINTS)))
     warm_tangent: np.ndarray = field(default_factory=lambda: np.zeros((1, MAX_POINTS, 3)))
+    fresh: Manifolds = field(default_factory=lambda: Manifolds.allocate(1))
+    stored: tuple = field(default_factory=lambda: _stored_contacts(1))
     contact_count: int = 0
+    steps_found_again: int = 0
     aabb_lo: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
     aabb_hi: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
     pairs: PairBuffer = field(default_factory=PairBuffer)
@@ -72,12 +80,25 @@ class Scratch:
     def backup(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         return self.backup_pos, self.backup_quat, self.backup_linvel, self.backup_angmom
 
-    def reserve_contacts(self, pair_count: int) -> None:
-        """Grow the contact buffers to hold one manifold per candidate pair (doubling, never shrinking)."""
+    def reserve_contacts(self, pair_count: int, keep: int = 0) -> None:
+        """Grow the pair and contact buffers to hold one manifold per candidate pair (doubling, never shrinking),
+        keeping the first ``keep`` rows of :attr:`stored`."""
+        self.pairs.reserve(pair_count)
         capacity = self.manifolds.shape_a.shape[0]
         if pair_count > capacity:
             capacity = max(pair_count, 2 * capacity)
             self.manifolds = Manifolds.allocate(capacity)
+            self.fresh = Manifolds.allocate(capacity)
+            stored, self.stored = self.stored, _stored_contacts(capacity)
+            for old, new in zip(stored, self.stored, strict=True):
+                new[:keep] = old[:keep]
             self.rows = ContactRows.allocate(capacity)
             self.warm_normal = np.zeros((capacity, MAX_POINTS))
             self.warm_tangent = np.zeros((capacity, MAX_POINTS, 3))
+
+
+def _stored_contacts(capacity: int) -> tuple[np.ndarray, ...]:
+    """Room for ``capacity`` manifolds of the contact state, in the order of ``state.CONTACT_FIELDS``."""
+    return (np.zeros(capacity, np.int64), np.zeros(capacity, np.int64), np.zeros(capacity, np.int64),
+            np.zeros((capacity, MAX_POINTS), np.int64), np.zeros((capacity, MAX_POINTS)),
+            np.zeros((capacity, MAX_POINTS, 3)))  # fmt: skip

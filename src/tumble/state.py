@@ -20,7 +20,7 @@ import numpy as np
 
 from .geometry.manifold import MAX_POINTS
 
-__all__ = ["State"]
+__all__ = ["CONTACT_FIELDS", "State"]
 
 _BODY_FIELDS = (
     "body_pos",
@@ -31,7 +31,7 @@ _BODY_FIELDS = (
     "body_sleeping",
     "body_island",
 )
-_CONTACT_FIELDS = (
+CONTACT_FIELDS = (
     "contact_shape_a",
     "contact_shape_b",
     "contact_point_count",
@@ -43,7 +43,7 @@ _CONTACT_FIELDS = (
 _JOINT_FIELDS = ("joint_linear_impulse", "joint_angular_impulse", "joint_drive_impulse")
 _JOINT_WIDTHS = (3, 3, 5)
 # Fields replaced (not written in place) when they change size: contacts every step, joints when added.
-_SIZED_FIELDS = _CONTACT_FIELDS + _JOINT_FIELDS
+_SIZED_FIELDS = CONTACT_FIELDS + _JOINT_FIELDS
 
 
 def _no_contacts() -> dict[str, np.ndarray]:

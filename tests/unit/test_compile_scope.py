@@ -1,8 +1,9 @@
 """What a world compiles (issue 23): only the code it runs, once per argument type.
 
-- A world without joints never types the joint solver, and the narrow phase compiles only the loops of the pair types
-  the world has (one kernel per collision function); checked in a fresh interpreter, where a kernel has signatures only
-  once something asked for it (compiled, or loaded from the cache).
+- Every world with contacts or joints steps through one compiled loop (issue 45), compiled once for all of them: the
+  narrow phase's loop of every pair type and the joint solver are in it, so that no new kind of world compiles a
+  second copy of the step (a minute each); checked in a fresh interpreter, where a kernel has signatures only once
+  something asked for it (compiled, or loaded from the cache).
 - A constant argument (``True``, an index ``0``, a shape code) does not compile a copy of the callee for its value:
   no compiled function of tumble has a literal type in a signature after a contact world, a jointed world and a hull
   world have stepped.
@@ -27,28 +28,33 @@ from tumble.shapes import ShapeType
 needs_jit = compiled_only("about compiled code")
 
 _PROBE = """
-import json, tumble
-from tumble.dynamics import joint_solver
-from tumble.geometry import narrow_phase
-world = tumble.World()
-world.add_static(tumble.Plane())
-world.add_body(tumble.Sphere(0.1), mass=1.0, position=(0, 0, 0.105))
-world.add_body(tumble.Box((0.1, 0.1, 0.1)), mass=1.0, position=(1.0, 0, 0.1))
-for _ in range(3):
-    world.step(1 / 60)
-print(json.dumps({
-    "solve_joints": len(joint_solver.solve_joints.signatures),
-    "pairs": sorted(k.py_func.__name__ for k in narrow_phase._PAIR_KERNELS if k.signatures),
-}))
+import json, numpy as np, tumble
+from tumble import runner
+worlds = []
+for shape in (tumble.Sphere(0.1), tumble.ConvexHull(np.random.default_rng(0).normal(size=(12, 3)) * 0.1)):
+    world = tumble.World()
+    world.add_static(tumble.Plane())
+    world.add_body(shape, mass=1.0, position=(0, 0, 0.3))
+    worlds.append(world)
+chain = tumble.World()
+a = chain.add_body(tumble.Box((0.1, 0.1, 0.1)), mass=1.0, position=(0, 0, 1.0))
+b = chain.add_body(tumble.Box((0.1, 0.1, 0.1)), mass=1.0, position=(0.2, 0, 1.0))
+chain.add_joint(tumble.HingeJoint(a, b, (0.1, 0, 1.0), (0, 1, 0)))
+worlds.append(chain)
+for world in worlds:
+    for _ in range(3):
+        world.step(1 / 60)
+    world.simulate(0.05, 1 / 240)
+tumble.Batch(worlds[0], 3).step(1 / 60, steps=2)
+print(json.dumps({"loops": len(runner._contact_loop.signatures)}))
 """
 
 
 @needs_jit
-def test_a_world_compiles_no_joint_solver_and_only_its_pair_types():
-    result = subprocess.run([sys.executable, "-c", _PROBE], capture_output=True, text=True, timeout=600)
+def test_every_contact_or_jointed_world_steps_through_one_compiled_loop():
+    result = subprocess.run([sys.executable, "-c", _PROBE], capture_output=True, text=True, timeout=900)
     assert result.returncode == 0, result.stderr[-3000:]
-    used = json.loads(result.stdout.strip().splitlines()[-1])
-    assert used == {"solve_joints": 0, "pairs": ["pairs_box_plane", "pairs_sphere_plane"]}
+    assert json.loads(result.stdout.strip().splitlines()[-1]) == {"loops": 1}
 
 
 def _literal_signatures() -> list[str]:
@@ -104,7 +110,7 @@ def test_every_type_pair_goes_to_its_collision_function():
         (hull, hull): "convex_convex", (s, mesh): "convex_trimesh", (hull, mesh): "convex_trimesh",
     }  # fmt: skip
     for (ta, tb), name in expected.items():
-        assert narrow_phase._PAIR_KERNELS[narrow_phase._COLLIDER_OF[ta, tb]].__name__ == f"pairs_{name}"
+        assert narrow_phase._PAIR_KERNELS[narrow_phase.COLLIDER_OF[ta, tb]].__name__ == f"pairs_{name}"
 
 
 def test_pairs_are_grouped_by_collision_function_in_pair_order():
@@ -114,8 +120,8 @@ def test_pairs_are_grouped_by_collision_function_in_pair_order():
     low = np.minimum(shape_type[pairs_a], shape_type[pairs_b]) == shape_type[pairs_a]
     pairs_a, pairs_b = np.where(low, pairs_a, pairs_b), np.where(low, pairs_b, pairs_a)  # lower shape type first
     order, starts = np.empty(300, np.int64), np.zeros(len(narrow_phase._COLLIDERS) + 1, np.int64)
-    narrow_phase._group_by_collider(shape_type, pairs_a, pairs_b, narrow_phase._COLLIDER_OF, order, starts)
-    which = narrow_phase._COLLIDER_OF[shape_type[pairs_a], shape_type[pairs_b]]
+    narrow_phase._group_by_collider(shape_type, pairs_a, pairs_b, narrow_phase.COLLIDER_OF, order, starts)
+    which = narrow_phase.COLLIDER_OF[shape_type[pairs_a], shape_type[pairs_b]]
     assert np.array_equal(order, np.argsort(which, kind="stable"))
     assert np.array_equal(np.diff(starts), np.bincount(which, minlength=len(narrow_phase._COLLIDERS)))
 
@@ -129,7 +135,7 @@ def test_touching_manifolds_move_to_the_front_in_pair_order():
     manifolds.point_count[40:] = 1  # beyond n: not counted, not moved
     before = type(manifolds)(*(field.copy() for field in manifolds))
     touching = np.flatnonzero(before.point_count[:40] > 0)
-    count = narrow_phase._keep_touching(manifolds, 40)
+    count = narrow_phase.keep_touching(manifolds, 40)
     assert 0 < count == touching.size < 40
     for field, old in zip(manifolds, before, strict=True):
         assert np.array_equal(field[:count], old[touching])
@@ -140,9 +146,10 @@ def test_touching_manifolds_move_to_the_front_in_pair_order():
 def test_the_free_body_integrator_compiles_its_per_body_calls_into_the_row_loop():
     """A compiled call reference-counts every array it receives: the per-body functions of the free-body integrator
     are compiled into their callers (Numba's ``inline="always"``), or every body would pay that once per call."""
-    from tumble import runner
+    from tumble import pipeline, runner
     from tumble.dynamics import integrate
 
-    for helper in (integrate.advance_rows, integrate._body_steps, runner._save_row, runner._restore_row):
+    for helper in (integrate.advance_rows, integrate._body_steps, runner._save_row, runner._restore_row,
+                   pipeline.contact_stages):  # fmt: skip
         assert helper.targetoptions.get("inline") == "always", helper.py_func.__name__
     assert "inline" not in math3d.dot.targetoptions  # the other helpers are left to LLVM

@@ -89,15 +89,21 @@ def test_npz_and_hdf5_round_trip_the_same_arrays_and_metadata(tmp_path):
 def test_a_failed_run_leaves_every_frame_before_the_failing_step(tmp_path, monkeypatch):
     """A step that goes non-finite mid-chunk: the frames of the chunks before it and of the good steps of its
     chunk are in the file, which is closed with status "failed"; the error carries the same frames."""
-    checked = runner._first_non_finite_body
+    world, loop = _pile(), runner._contact_loop
 
-    def fail_at_step_23(state, *args):
-        return 3 if state.step_count == 23 else checked(state, *args)  # step_count is that before the step
+    def fail_at_step_23(*args):
+        """The runner's compiled loop, up to the world's step 23, which body 3 fails (the world as before it)."""
+        *head, first, n_steps = args
+        stop = 23 - world.step_count  # the call's step that is the world's step 23
+        if not first <= stop < n_steps:
+            return loop(*args)
+        done, failing, count, needed = loop(*head, first, stop)
+        return (done, failing, count, needed) if failing >= 0 or needed > 0 else (stop, 3, count, 0)
 
-    monkeypatch.setattr(runner, "_first_non_finite_body", fail_at_step_23)
+    monkeypatch.setattr(runner, "_contact_loop", fail_at_step_23)
     path = tmp_path / "failed.h5"
     with pytest.raises(tumble.SimulationError, match="box2") as info:
-        recording.record(_pile(), 1.0, DT, path, chunk_frames=10)
+        recording.record(world, 1.0, DT, path, chunk_frames=10)
     loaded = tumble.Trajectory.load(path)
     assert len(loaded) == 24  # the initial state and steps 1..23
     assert loaded.metadata["status"] == "failed" and "box2" in loaded.metadata["error"]

@@ -9,8 +9,9 @@ import tumble
 
 
 def _calls_of_one_step(world: tumble.World) -> tuple[list[str], list[str]]:
-    """``(stack, visited)``: the tumble modules on the stack when ``pipeline.contact_step`` is entered, outermost
-    first (each once), and every tumble module the step called into."""
+    """``(stack, visited)``: the tumble modules on the stack when the pipeline is first entered (the runner takes the
+    arrays of its stages from it, then steps in compiled code), outermost first (each once), and every tumble module
+    the step called into."""
     stack: list[str] = []
     visited: set[str] = set()
 
@@ -21,7 +22,7 @@ def _calls_of_one_step(world: tumble.World) -> tuple[list[str], list[str]]:
         if not module.startswith("tumble"):
             return
         visited.add(module)
-        if module == "tumble.pipeline" and frame.f_code.co_name == "contact_step" and not stack:
+        if module == "tumble.pipeline" and not stack:
             outer = frame
             while outer is not None:
                 name = outer.f_globals.get("__name__", "")

@@ -26,7 +26,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .._jit import inline, kernel
+from .._jit import inline
 from .._validate import as_float
 from ..geometry.manifold import MAX_POINTS
 from ..math3d import (
@@ -73,6 +73,7 @@ __all__ = [
     "prepare_contacts",
     "rebase_contacts",
     "solve_contacts",
+    "store_impulses",
     "warm_start_contacts",
 ]
 
@@ -210,7 +211,7 @@ def _write_rolling_masses(rows, m, ia, ib, t1, t2):
         rows.rolling_mass[m, 1] = _inverse_angular_mass(ia, ib, t2)
 
 
-@kernel
+@inline
 def prepare_contacts(
     manifolds, count, shape_body, shape_friction, shape_restitution, shape_rolling, shape_core_radius, inv_mass,
     inv_inertia_world, pos, linvel,
@@ -269,7 +270,7 @@ def prepare_contacts(
                 rows.sweeps[m] = IMPACT_SWEEPS
 
 
-@kernel
+@inline
 def rebase_contacts(listed, fresh, manifolds, rows, inv_mass, inv_inertia_world, pos, quat, pos0, quat0, linvel,
                     angvel):  # fmt: skip
     """Put the contacts found again within the step into their rows: ``fresh[i]``, found at the bodies' poses now,
@@ -653,7 +654,7 @@ def resolve_impacts(rows, count, inv_mass, inv_inertia_world, pos, quat, pos0, q
             break
 
 
-@kernel
+@inline
 def apply_restitution(rows, count, inv_mass, inv_inertia_world, pos, quat, pos0, quat0, linvel, angvel, threshold):
     """Bounce: drive the normal velocity to ``−e`` times its approach velocity, where there was an impact that
     :func:`resolve_impacts` did not bounce (one that sped up past ``threshold`` only in the substep it touched).
@@ -690,3 +691,24 @@ def accumulate_impulses(rows, count):
             rows.total_normal_impulse[m, j] += rows.normal_impulse[m, j]
             rows.total_tangent_impulse[m, j, 0] += rows.tangent_impulse[m, j, 0]
             rows.total_tangent_impulse[m, j, 1] += rows.tangent_impulse[m, j, 1]
+
+
+@inline
+def store_impulses(manifolds, rows, count, shape_a, shape_b, point_count, feature, normal_impulse, tangent_impulse):
+    """Keep this step's impulses, keyed by shape pair and feature, to warm-start the next step: the first ``count``
+    rows of the contact state's arrays (``State.contact_*``), friction as world vectors. Slots past each manifold's
+    point count hold leftovers of earlier steps: they are zeroed, so that the state (and its digest) holds only
+    what the next step reads."""
+    for m in range(count):
+        shape_a[m], shape_b[m] = manifolds.shape_a[m], manifolds.shape_b[m]
+        point_count[m] = manifolds.point_count[m]
+        for j in range(MAX_POINTS):
+            used = j < point_count[m]
+            feature[m, j] = manifolds.feature[m, j] if used else 0
+            normal_impulse[m, j] = rows.normal_impulse[m, j] if used else 0.0
+            for i in range(3):
+                along = (
+                    rows.tangent_impulse[m, j, 0] * rows.tangent1[m, i]
+                    + rows.tangent_impulse[m, j, 1] * rows.tangent2[m, i]
+                )
+                tangent_impulse[m, j, i] = along if used else 0.0

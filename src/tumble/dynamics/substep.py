@@ -49,7 +49,7 @@ def to_angular_velocity(bodies, quat, angmom, angvel, inv_inertia_world):
             inv_inertia_world[i, 2, c] = column[2]
 
 
-@kernel
+@inline
 def to_angular_momentum(bodies, quat, angvel, angmom):
     """``L = R I Rᵀ ω`` of every dynamic body. Writes: angmom."""
     for i in range(quat.shape[0]):
@@ -89,7 +89,7 @@ def integrate_positions(moving, linvel, angvel, pos, quat, h):
             store4(quat, i, quat_integrate(load4(quat, i), load3(angvel, i), h))
 
 
-@kernel
+@inline
 def run_substeps(
     bodies, moving, inv_mass, gravity, force, torque, acts, rows, count, inv_inertia_world, pos, quat, pos0, quat0,
     linvel, angvel, h, first, last, push_max, threshold, joints, joint_impulses, joint_hertz, joint_damping_ratio,
@@ -100,25 +100,25 @@ def run_substeps(
     integrate positions, relax without bias. The step runs them in one call, or in several where contacts are found
     again between them (``pipeline.contact_step``); the state between calls is all in the arrays.
     ``inv_mass`` and ``inv_inertia_world`` are zero for bodies that do not move (static or sleeping), which the
-    solver then treats as fixed. ``joints`` is None in a world without joints: Numba prunes the joint solver's
-    branches before typing, so such a world never compiles it."""
+    solver then treats as fixed."""
     inv_h = 1.0 / h
+    jointed = joints.kind.shape[0] > 0  # without joints, not even the joint solver's work arrays
     for k in range(first, last):
         integrate_velocities(bodies, moving, gravity, force, torque, acts, k * h, quat, linvel, angvel, h)
         resolve_impacts(rows, count, inv_mass, inv_inertia_world, pos, quat, pos0, quat0, linvel, angvel, h, threshold,
                         gravity, force, bodies.constant_force)  # fmt: skip
-        if joints is not None:
+        if jointed:
             warm_start_joints(joints, joint_impulses, inv_mass, inv_inertia_world, pos, quat, linvel, angvel,
                               joint_force_total, joint_moment_total)  # fmt: skip
         warm_start_contacts(rows, count, inv_mass, inv_inertia_world, pos, quat, pos0, quat0, linvel, angvel)
-        if joints is not None:
+        if jointed:
             solve_joints(joints, joint_impulses, inv_mass, inv_inertia_world, pos, quat, linvel, angvel, h,
                          joint_hertz, joint_damping_ratio, push_max, True, joint_force_total,
                          joint_moment_total)  # fmt: skip
         solve_contacts(rows, count, inv_mass, inv_inertia_world, pos, quat, pos0, quat0, linvel, angvel, inv_h,
                        push_max, True, threshold)  # fmt: skip
         integrate_positions(moving, linvel, angvel, pos, quat, h)
-        if joints is not None:
+        if jointed:
             solve_joints(joints, joint_impulses, inv_mass, inv_inertia_world, pos, quat, linvel, angvel, h,
                          joint_hertz, joint_damping_ratio, push_max, False, joint_force_total,
                          joint_moment_total)  # fmt: skip

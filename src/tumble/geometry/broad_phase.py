@@ -10,12 +10,13 @@ it along the body's displacement over the step.
 lower bound on one axis, then walk the sorted list; a box can only overlap the boxes that start before it ends,
 so the inner loop stops at the first box that starts after it. That costs O(n log n) for the sort plus O(n + k)
 for k overlaps on the axis. The axis is the one along which the box centres vary most (Ericson's choice in
-§7.5.2): in a pile spread over a floor that is a horizontal axis, never the stacking one. The sort is a NumPy
-``argsort`` each call rather than an insertion sort kept from the last step: it needs no state, so throwing the
-scratch away never changes a result, and it is not where the time goes (5000 boxes after one step of motion:
-argsort 0.16-0.49 ms, an insertion sort from the last order 0.14-0.19 ms, the sweep 6-22 ms). Planes have no
-finite box and are tested apart against every box. The pairs come out sorted by ``(shape_a, shape_b)`` whatever
-the input order, so the narrow phase and the solver see them deterministically.
+§7.5.2): in a pile spread over a floor that is a horizontal axis, never the stacking one. The sort is a full sort
+each call rather than an insertion sort kept from the last step: it needs no state, so throwing the scratch away
+never changes a result, and it is not where the time goes (5000 boxes after one step of motion: argsort
+0.16-0.49 ms, an insertion sort from the last order 0.14-0.19 ms, the sweep 6-22 ms). Planes have no finite box and
+are tested apart against every box. The pairs come out sorted by ``(shape_a, shape_b)`` whatever the input order,
+so the narrow phase and the solver see them deterministically. :func:`sweep_and_prune` is all of it in one
+compiled call (the contact step's); :func:`find_pairs` calls it from Python.
 
 :func:`find_pairs_brute_force` tests every pair with NumPy: the readable reference and the tests' oracle.
 """
@@ -35,6 +36,8 @@ __all__ = [
     "update_aabbs",
     "find_pairs",
     "find_pairs_brute_force",
+    "pair_filters",
+    "sweep_and_prune",
     "exclusion_table",
     "PairBuffer",
     "DEFAULT_GROUP",
@@ -166,7 +169,7 @@ def _emit(shape_type, a, b, out_a, out_b, count):
 # --- sweep ---------------------------------------------------------------------------------------------
 
 
-@kernel
+@inline
 def _sweep_kernel(
     order, segment_size, sorted_lo, sorted_hi, shape_type, shape_body, body_is_dynamic, shape_group, shape_mask,
     excluded, out_a, out_b, count,
@@ -195,7 +198,7 @@ def _sweep_kernel(
     return count
 
 
-@kernel
+@inline
 def _plane_kernel(
     planes, boxes, segment_size, geom, body_pos, body_quat, aabb_lo, aabb_hi, body_is_dynamic, shape_group, shape_mask,
     excluded, margin, out_a, out_b, count,
@@ -283,7 +286,9 @@ def _is_exclusion_table(table: np.ndarray) -> bool:
     return bool(np.all((first[:, 0] > second[:, 0]) | ((first[:, 0] == second[:, 0]) & (first[:, 1] > second[:, 1]))))
 
 
-def _filter_arrays(shape_count, shape_group, shape_mask, excluded_body_pairs):
+def pair_filters(shape_count, shape_group=None, shape_mask=None, excluded_body_pairs=None):
+    """``(group, mask, excluded)`` as the kernels take them: uint32 filter bits (the defaults where None) and the
+    excluded body pairs as an :func:`exclusion_table`."""
     group = np.full(shape_count, DEFAULT_GROUP, np.uint32) if shape_group is None else np.asarray(shape_group)
     mask = np.full(shape_count, DEFAULT_MASK, np.uint32) if shape_mask is None else np.asarray(shape_mask)
     group, mask = group.astype(np.uint32, copy=False), mask.astype(np.uint32, copy=False)
@@ -294,12 +299,6 @@ def _filter_arrays(shape_count, shape_group, shape_mask, excluded_body_pairs):
         if not _is_exclusion_table(excluded):
             excluded = exclusion_table(excluded)
     return group, mask, excluded
-
-
-def _sorted_pairs(pairs_a: np.ndarray, pairs_b: np.ndarray, shape_count: int) -> tuple[np.ndarray, np.ndarray]:
-    """Sort pairs by ``(a, b)`` through the key ``a n + b`` (exact in int64 up to 3·10⁹ shapes)."""
-    key = np.sort(pairs_a * shape_count + pairs_b)
-    return key // shape_count, key % shape_count
 
 
 def find_pairs(
@@ -346,37 +345,87 @@ def find_pairs(
     """
     shape_count = int(geom.shape_type.shape[0])
     body_is_dynamic = np.asarray(body_is_dynamic, dtype=bool)
-    group, mask, excluded = _filter_arrays(shape_count, shape_group, shape_mask, excluded_body_pairs)
-    is_plane = geom.shape_type == _PLANE
-    boxes, planes = np.flatnonzero(~is_plane), np.flatnonzero(is_plane)
-    # Sweep along the axis of largest spread of the box centres (Ericson 2005, §7.5.2).
-    axis = 0
-    if boxes.shape[0] > 1:
-        centers = aabb_lo[boxes] + aabb_hi[boxes]
-        axis = int(np.argmax(centers.var(axis=0)))
-    if segment_size > 0:  # by segment, then along the axis
-        order = boxes[np.lexsort((aabb_lo[boxes, axis], boxes // segment_size))]
-    else:
-        order = boxes[np.argsort(aabb_lo[boxes, axis], kind="stable")]
-    columns = [axis, (axis + 1) % 3, (axis + 2) % 3]
-    sorted_lo = np.ascontiguousarray(aabb_lo[order][:, columns])
-    sorted_hi = np.ascontiguousarray(aabb_hi[order][:, columns])
+    group, mask, excluded = pair_filters(shape_count, shape_group, shape_mask, excluded_body_pairs)
     if buffer is None:
         buffer = PairBuffer(max(64, 2 * shape_count))
     while True:
-        count = _sweep_kernel(
-            order, int(segment_size), sorted_lo, sorted_hi, geom.shape_type, geom.shape_body, body_is_dynamic, group,
-            mask, excluded, buffer.a, buffer.b, 0,
-        )  # fmt: skip
-        count = _plane_kernel(
-            planes, boxes, int(segment_size), geom, body_pos, body_quat, aabb_lo, aabb_hi, body_is_dynamic, group,
-            mask, excluded, float(margin), buffer.a, buffer.b, count,
-        )  # fmt: skip
+        count = sweep_and_prune(geom, body_pos, body_quat, aabb_lo, aabb_hi, body_is_dynamic, group, mask, excluded,
+                                float(margin), int(segment_size), buffer.a, buffer.b)  # fmt: skip
         if count <= buffer.capacity:
-            break
+            return buffer.a[:count].copy(), buffer.b[:count].copy()
         # The kernels counted every pair but wrote only what fitted: grow to the count and run again.
         buffer.reserve(count)
-    return _sorted_pairs(buffer.a[:count], buffer.b[:count], shape_count)
+
+
+@kernel
+def sweep_and_prune(geom, body_pos, body_quat, aabb_lo, aabb_hi, body_is_dynamic, shape_group, shape_mask, excluded,
+                    margin, segment_size, out_a, out_b):  # fmt: skip
+    """:func:`find_pairs` in one compiled call, into ``out_a``, ``out_b`` sorted by ``(a, b)``: returns the pair
+    count, which is more than ``out_a`` holds when it must grow (then only what fitted was written, unsorted).
+    ``shape_group``, ``shape_mask``, ``excluded`` as :func:`pair_filters` gives them."""
+    n = geom.shape_type.shape[0]
+    box_count = 0
+    for s in range(n):
+        box_count += geom.shape_type[s] != _PLANE
+    boxes, planes = np.empty(box_count, np.int64), np.empty(n - box_count, np.int64)
+    i = j = 0
+    for s in range(n):
+        if geom.shape_type[s] != _PLANE:
+            boxes[i] = s
+            i += 1
+        else:
+            planes[j] = s
+            j += 1
+    axis = _sweep_axis(boxes, aabb_lo, aabb_hi)
+    order = boxes[_sweep_order(boxes, aabb_lo, axis, segment_size)]
+    sorted_lo, sorted_hi = np.empty((box_count, 3)), np.empty((box_count, 3))
+    for k in range(box_count):
+        for c in range(3):  # the sweep axis first, so that the sweep reads memory in sequence
+            sorted_lo[k, c] = aabb_lo[order[k], (axis + c) % 3]
+            sorted_hi[k, c] = aabb_hi[order[k], (axis + c) % 3]
+    count = _sweep_kernel(order, segment_size, sorted_lo, sorted_hi, geom.shape_type, geom.shape_body,
+                          body_is_dynamic, shape_group, shape_mask, excluded, out_a, out_b, 0)  # fmt: skip
+    count = _plane_kernel(planes, boxes, segment_size, geom, body_pos, body_quat, aabb_lo, aabb_hi, body_is_dynamic,
+                          shape_group, shape_mask, excluded, margin, out_a, out_b, count)  # fmt: skip
+    if count <= out_a.shape[0]:
+        # By the key a n + b (exact in int64 up to 3·10⁹ shapes): unique, so any sort gives the same order.
+        key = np.sort(out_a[:count] * n + out_b[:count])
+        for k in range(count):
+            out_a[k], out_b[k] = key[k] // n, key[k] % n
+    return count
+
+
+@inline
+def _sweep_axis(boxes, aabb_lo, aabb_hi):
+    """The axis along which the box centres spread most (Ericson 2005, §7.5.2): any axis finds the same pairs, this
+    one fewest candidates on the way."""
+    if boxes.shape[0] < 2:
+        return 0
+    best, axis = -1.0, 0
+    for c in range(3):
+        mean = 0.0
+        for s in boxes:
+            mean += aabb_lo[s, c] + aabb_hi[s, c]
+        mean /= boxes.shape[0]
+        spread = 0.0
+        for s in boxes:
+            spread += (aabb_lo[s, c] + aabb_hi[s, c] - mean) ** 2
+        if spread > best:
+            best, axis = spread, c
+    return axis
+
+
+@inline
+def _sweep_order(boxes, aabb_lo, axis, segment_size):
+    """The boxes' order for the sweep: by segment (row // ``segment_size``, when > 0), then by lower bound on
+    ``axis`` (two stable sorts)."""
+    lower = np.empty(boxes.shape[0])
+    for k in range(boxes.shape[0]):
+        lower[k] = aabb_lo[boxes[k], axis]
+    order = np.argsort(lower, kind="mergesort")
+    if segment_size > 0:
+        order = order[np.argsort(boxes[order] // segment_size, kind="mergesort")]
+    return order
 
 
 def find_pairs_brute_force(
@@ -400,7 +449,7 @@ def find_pairs_brute_force(
 
     n = int(geom.shape_type.shape[0])
     shape_type, shape_body = geom.shape_type, geom.shape_body
-    group, mask, _ = _filter_arrays(n, shape_group, shape_mask, None)
+    group, mask, _ = pair_filters(n, shape_group, shape_mask, None)
     rows = [] if excluded_body_pairs is None else np.asarray(excluded_body_pairs, np.int64).reshape(-1, 2)
     excluded = {(min(int(i), int(j)), max(int(i), int(j))) for i, j in rows}
     is_plane = shape_type == _PLANE

@@ -30,7 +30,17 @@ from .collide_primitives import (
 )
 from .manifold import Manifolds
 
-__all__ = ["collide_each", "collide_pairs", "contact_passes", "match_warm_start", "shape_world_pose"]
+__all__ = [
+    "COLLIDER_OF",
+    "collide_each",
+    "collide_pairs",
+    "compiled_collide_each",
+    "keep_touching",
+    "contact_passes",
+    "match_warm_start",
+    "passes_due",
+    "shape_world_pose",
+]
 
 SPHERE, CAPSULE, BOX, CYLINDER, HULL, PLANE, TRIMESH = 0, 1, 2, 3, 4, 5, 6
 # A pair whose bodies can close or turn by more than this fraction of the smaller moving shape's bounding radius in
@@ -124,7 +134,8 @@ def _collider_table() -> np.ndarray:
     return table
 
 
-_COLLIDER_OF = _collider_table()
+COLLIDER_OF = _collider_table()
+_COLLIDER_COUNT = len(_COLLIDERS)
 
 
 @kernel
@@ -146,7 +157,7 @@ def _group_by_collider(shape_type, pairs_a, pairs_b, table, order, starts):
 
 
 @kernel
-def _keep_touching(manifolds, n):
+def keep_touching(manifolds, n):
     """Move the manifolds of the first ``n`` pairs that have points to the front, in order; returns how many.
     Element by element: row copies of the 2-D and 3-D fields compiled six times slower (5.7 s against 1.0 s)."""
     count = 0
@@ -178,7 +189,7 @@ def collide_pairs(geom, body_pos, body_quat, body_linvel, body_angvel, pairs_a, 
     if n == 0:
         return 0
     collide_each(geom, body_pos, body_quat, body_linvel, body_angvel, pairs_a, pairs_b, margin, dt, manifolds)
-    return _keep_touching(manifolds, n)
+    return keep_touching(manifolds, n)
 
 
 def collide_each(geom, body_pos, body_quat, body_linvel, body_angvel, pairs_a, pairs_b, margin, dt, manifolds):
@@ -187,12 +198,69 @@ def collide_each(geom, body_pos, body_quat, body_linvel, body_angvel, pairs_a, p
     kernel (:data:`_PAIR_KERNELS`)."""
     n = pairs_a.shape[0]
     order, starts = np.empty(n, dtype=np.int64), np.zeros(len(_COLLIDERS) + 1, dtype=np.int64)
-    _group_by_collider(geom.shape_type, pairs_a, pairs_b, _COLLIDER_OF, order, starts)
+    _group_by_collider(geom.shape_type, pairs_a, pairs_b, COLLIDER_OF, order, starts)
     args = (geom, body_pos, body_quat, body_linvel, body_angvel, pairs_a, pairs_b)
     bounds = starts.tolist()
     for i, run in enumerate(_PAIR_KERNELS):
         if bounds[i + 1] > bounds[i]:
             run(*args, order[bounds[i] : bounds[i + 1]], margin, dt, manifolds)
+
+
+def _each_template(geom, body_pos, body_quat, body_linvel, body_angvel, pairs_a, pairs_b, margin, dt, manifolds,
+                   table):  # fmt: skip
+    """:func:`collide_each` as compiled code calls it (:data:`compiled_collide_each`): each collision function's pairs
+    to its loop ``loop_i`` (bound by :func:`kernel_for`).
+    ``table`` is :data:`COLLIDER_OF` (an argument: a global array would keep the kernel out of the cache)."""
+    n = pairs_a.shape[0]
+    order, starts = np.empty(n, np.int64), np.zeros(_COLLIDER_COUNT + 1, np.int64)
+    _group_by_collider(geom.shape_type, pairs_a, pairs_b, table, order, starts)
+    args = (geom, body_pos, body_quat, body_linvel, body_angvel, pairs_a, pairs_b)
+    # One block per collision function (a dispatcher passed as an argument would keep the kernel out of the cache).
+    if starts[1] > starts[0]:
+        loop_0(*args, order[starts[0] : starts[1]], margin, dt, manifolds)  # noqa: F821
+    if starts[2] > starts[1]:
+        loop_1(*args, order[starts[1] : starts[2]], margin, dt, manifolds)  # noqa: F821
+    if starts[3] > starts[2]:
+        loop_2(*args, order[starts[2] : starts[3]], margin, dt, manifolds)  # noqa: F821
+    if starts[4] > starts[3]:
+        loop_3(*args, order[starts[3] : starts[4]], margin, dt, manifolds)  # noqa: F821
+    if starts[5] > starts[4]:
+        loop_4(*args, order[starts[4] : starts[5]], margin, dt, manifolds)  # noqa: F821
+    if starts[6] > starts[5]:
+        loop_5(*args, order[starts[5] : starts[6]], margin, dt, manifolds)  # noqa: F821
+    if starts[7] > starts[6]:
+        loop_6(*args, order[starts[6] : starts[7]], margin, dt, manifolds)  # noqa: F821
+    if starts[8] > starts[7]:
+        loop_7(*args, order[starts[7] : starts[8]], margin, dt, manifolds)  # noqa: F821
+    if starts[9] > starts[8]:
+        loop_8(*args, order[starts[8] : starts[9]], margin, dt, manifolds)  # noqa: F821
+    if starts[10] > starts[9]:
+        loop_9(*args, order[starts[9] : starts[10]], margin, dt, manifolds)  # noqa: F821
+    if starts[11] > starts[10]:
+        loop_10(*args, order[starts[10] : starts[11]], margin, dt, manifolds)  # noqa: F821
+    if starts[12] > starts[11]:
+        loop_11(*args, order[starts[11] : starts[12]], margin, dt, manifolds)  # noqa: F821
+    if starts[13] > starts[12]:
+        loop_12(*args, order[starts[12] : starts[13]], margin, dt, manifolds)  # noqa: F821
+
+
+# collide_each for compiled code: every collision function's loop bound in (one copy for every world; the loops of
+# pair types a world lacks are compiled but never run).
+compiled_collide_each = kernel_for(
+    _each_template, "compiled_collide_each", **{f"loop_{i}": loop for i, loop in enumerate(_PAIR_KERNELS)}
+)
+
+
+@inline
+def passes_due(passes, count, k, substeps, listed):
+    """The manifolds whose contacts are found again before substep ``k``, into ``listed``; returns how many:
+    ``passes[m]`` equal runs of the substeps for manifold ``m`` (as equal as whole substeps allow)."""
+    due = 0
+    for m in range(count):
+        if (k * passes[m]) // substeps > ((k - 1) * passes[m]) // substeps:
+            listed[due] = m
+            due += 1
+    return due
 
 
 @kernel
@@ -234,7 +302,7 @@ def contact_passes(shape_body, aabb_center_local, aabb_half_local, moving, shape
     return most
 
 
-@kernel
+@inline
 def match_warm_start(
     manifolds, count, prev_a, prev_b, prev_point_count, prev_feature, prev_normal, prev_tangent, warm_normal,
     warm_tangent,

@@ -25,7 +25,7 @@ import math
 
 import numpy as np
 
-from .. import elementary, portable
+from .. import elementary
 from .._jit import inline, kernel
 from ..math3d import add, dot, load3, load4, quat_conj, quat_mul, quat_rotate, quat_rotate_inv, scale, sub
 from ..shapes import ShapeType
@@ -39,51 +39,69 @@ _MAX_ITERATIONS = 32
 _PLANE, _TRIMESH = int(ShapeType.PLANE), int(ShapeType.TRIMESH)
 
 
-def limit_to_impact(geom, body_is_dynamic, pairs_a, pairs_b, pos0, quat0, pos, quat, body_may_move=None) -> int:
+@inline
+def limit_to_impact(geom, body_is_dynamic, pairs_a, pairs_b, pos0, quat0, pos, quat, body_may_move):
     """Move fast bodies back to their first touch with static geometry this step; returns how many moved.
 
     Reads: the broad phase's pairs, body poses at the start of the step (``pos0``, ``quat0``) and now, and
-    ``body_may_move`` (default: every dynamic body), the bodies that may be moved back on their own.
+    ``body_may_move``, the bodies that may be moved back on their own (free to sweep: not jointed).
     Writes: ``pos``, ``quat`` of the bodies that would have passed into a static shape.
     """
-    if pairs_a.shape[0] == 0:
-        return 0
-    body_a, body_b = geom.shape_body[pairs_a], geom.shape_body[pairs_b]
-    static_a, static_b = ~body_is_dynamic[body_a], ~body_is_dynamic[body_b]
     # One side static (not a plane), the other dynamic: the moving shape first.
-    one_static = static_a != static_b
-    moving = np.where(static_b, pairs_a, pairs_b)[one_static]
-    fixed = np.where(static_b, pairs_b, pairs_a)[one_static]
-    keep = geom.shape_type[fixed] != _PLANE
-    moving, fixed = moving[keep], fixed[keep]
-    if moving.size == 0:
+    moving, fixed = np.empty(pairs_a.shape[0], np.int64), np.empty(pairs_a.shape[0], np.int64)
+    count = 0
+    for k in range(pairs_a.shape[0]):
+        static_a = not body_is_dynamic[geom.shape_body[pairs_a[k]]]
+        static_b = not body_is_dynamic[geom.shape_body[pairs_b[k]]]
+        if static_a == static_b:
+            continue
+        m, f = (pairs_a[k], pairs_b[k]) if static_b else (pairs_b[k], pairs_a[k])
+        if geom.shape_type[f] != _PLANE:
+            moving[count], fixed[count] = m, f
+            count += 1
+    if count == 0:
         return 0
     fast = _fast_bodies(geom, pos0, quat0, pos, quat)
-    if body_may_move is not None:
-        fast &= body_may_move
-    keep = fast[geom.shape_body[moving]]
-    if not keep.any():
+    swept = 0
+    for k in range(count):
+        b = geom.shape_body[moving[k]]
+        if fast[b] and body_may_move[b]:
+            moving[swept], fixed[swept] = moving[k], fixed[k]
+            swept += 1
+    if swept == 0:
         return 0
     t_hit = np.ones(pos.shape[0])
-    _sweep_pairs(geom, moving[keep], fixed[keep], pos0, quat0, pos, quat, TOI_TARGET, t_hit)
+    _sweep_pairs(geom, moving[:swept], fixed[:swept], pos0, quat0, pos, quat, TOI_TARGET, t_hit)
     hit = np.flatnonzero(t_hit < 1.0)
-    if hit.size:
-        _move_to_impact(hit, t_hit, pos0, quat0, pos, quat)
-    return int(hit.size)
+    _move_to_impact(hit, t_hit, pos0, quat0, pos, quat)
+    return hit.shape[0]
 
 
-def _fast_bodies(geom, pos0, quat0, pos, quat) -> np.ndarray:
-    """Bodies whose shapes moved more than half their smallest half-extent during the step."""
+@inline
+def _fast_bodies(geom, pos0, quat0, pos, quat):
+    """Bodies whose shapes moved more than half their smallest half-extent during the step: the turn counts at the
+    farthest reach of the body's shapes from its centre of mass."""
     n = pos.shape[0]
-    half = geom.shape_aabb_half_local
-    smallest = np.full(n, np.inf)
-    np.minimum.at(smallest, geom.shape_body, half.min(axis=1))
-    reach = np.zeros(n)
-    np.maximum.at(reach, geom.shape_body, np.linalg.norm(geom.shape_aabb_center_local, axis=1)
-                  + np.linalg.norm(half, axis=1))  # fmt: skip
-    turn = np.abs(np.sum(quat * quat0, axis=1)).clip(0.0, 1.0)
-    motion = np.linalg.norm(pos - pos0, axis=1) + 2.0 * portable.arccos(turn) * np.where(np.isfinite(reach), reach, 0.0)
-    return motion > 0.5 * smallest
+    smallest, reach = np.full(n, np.inf), np.zeros(n)
+    for s in range(geom.shape_body.shape[0]):
+        b = geom.shape_body[s]
+        c, h = load3(geom.shape_aabb_center_local, s), load3(geom.shape_aabb_half_local, s)
+        smallest[b] = min(smallest[b], h[0], h[1], h[2])
+        reach[b] = max(reach[b], _norm(c) + _norm(h))
+    fast = np.zeros(n, np.bool_)
+    for i in range(n):
+        q, q0 = load4(quat, i), load4(quat0, i)
+        turn = min(max(abs(((q[0] * q0[0] + q[1] * q0[1]) + q[2] * q0[2]) + q[3] * q0[3]), 0.0), 1.0)
+        lever = reach[i] if math.isfinite(reach[i]) else 0.0
+        motion = _norm(sub(load3(pos, i), load3(pos0, i))) + 2.0 * elementary.acos(turn) * lever
+        fast[i] = motion > 0.5 * smallest[i]
+    return fast
+
+
+@inline
+def _norm(v):
+    """``|v|``, summed in NumPy's order (``np.linalg.norm`` of a row)."""
+    return math.sqrt((v[0] * v[0] + v[1] * v[1]) + v[2] * v[2])
 
 
 @inline
@@ -152,7 +170,7 @@ def _advance(geom, proxy, offset, offset_quat, reach, x0, q0, x1, q1, k, pk, qk,
     return t
 
 
-@kernel
+@inline
 def _sweep_pairs(geom, moving, fixed, pos0, quat0, pos, quat, target, t_hit):
     """The earliest touch of each fast body with static geometry this step (``t_hit``, left at 1 when none).
 
@@ -179,7 +197,7 @@ def _sweep_pairs(geom, moving, fixed, pos0, quat0, pos, quat, target, t_hit):
             t_hit[b] = t
 
 
-@kernel
+@inline
 def _move_to_impact(bodies, t_hit, pos0, quat0, pos, quat):
     for i in bodies:
         x, q = _pose_at(load3(pos0, i), load4(quat0, i), load3(pos, i), load4(quat, i), t_hit[i])
