@@ -151,8 +151,8 @@ class Controllers:
           controller that fails raises :func:`controller_failed`'s error, the world as it was;
         - ``compiled_command`` and ``compiled_data``: a compiled function ``compiled_command(compiled_data, gravity,
           acts, pos, quat, linvel, angmom, t, h)`` that does what ``command`` does and returns the index of the
-          controller that failed, or -1. The runner's compiled loop (``tumble.runner``) calls it before each step of
-          a world of free bodies, so that all the steps of ``simulate`` take one call;
+          controller that failed, or -1. The runner's compiled loops (``tumble.runner``: free bodies, or contacts and
+          joints) call it before each step, so that all the steps of ``simulate`` take one call;
         - ``failure(index, t, step)``: the error of the controller ``compiled_command`` said failed, before the step
           ``step`` from ``t``;
         - ``finish()``: the calls made, the next ticks and the controllers' own state handed back to them.

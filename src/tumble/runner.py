@@ -26,7 +26,7 @@ from typing import NamedTuple
 import numpy as np
 
 from . import pipeline
-from ._jit import inline, kernel, kernel_for
+from ._jit import inline, kernel_for
 from .dynamics import integrate
 from .dynamics.actuation import ActuatorArrays, advance_motors
 from .dynamics.integrate import Recording, advance_rows
@@ -68,16 +68,14 @@ def simulate_steps(
 
     ``acts`` are the actuators, drag and wind (none if ``None``); their motors' speeds advance with the steps.
     ``stage`` is a compiled controller stage (``tumble.controllers.Controllers.compiled_stage``) that commands the
-    actuators before each step of a world of free bodies; the step ``s`` starts at ``clock[0] + (clock[1] + s) h``,
-    as the world's ``StepClock`` counts.
+    actuators before each step; the step ``s`` starts at ``clock[0] + (clock[1] + s) h``, as the world's
+    ``StepClock`` counts.
     """
     if acts is None:
         acts = ActuatorArrays.empty(model.body_count)
     if model.has_constraints:
-        if stage is not None:
-            raise ValueError("a compiled stage runs in the free bodies' loop; a world with contacts or joints "
-                             "calls stage.command before each step")  # fmt: skip
-        steps = _contact_steps(model, state, inputs, params, scratch, h, n_steps, recording, record_every, acts)
+        steps = _contact_steps(model, state, inputs, params, scratch, h, n_steps, recording, record_every, acts,
+                               stage, clock)  # fmt: skip
     else:
         if recording is None:
             recording, record_every = scratch.no_recording, 0
@@ -227,8 +225,9 @@ def step_by_step(n_steps: int, one_step, recording: Recording, record_every: int
     return Steps(n_steps)
 
 
-def _contact_steps(model, state, inputs, params, scratch, h, n_steps, recording, record_every, acts):
-    """Soft steps in the compiled loop (:func:`_contact_loop`); on a non-finite value the state before that step."""
+def _contact_steps(model, state, inputs, params, scratch, h, n_steps, recording, record_every, acts, stage, clock):
+    """Soft steps in the compiled loop (:func:`_contact_loop`, with the ``stage``'s command bound in when there is
+    one); on a non-finite value the state before that step."""
     if params.resolve_integrator(True) != Integrator.SYMPLECTIC:
         raise ValueError(
             f"integrator={params.integrator!r} integrates free bodies only; a world whose shapes can touch or whose "
@@ -247,12 +246,16 @@ def _contact_steps(model, state, inputs, params, scratch, h, n_steps, recording,
     idle = (np.zeros_like(inputs.body_force), np.zeros_like(inputs.body_torque), acts)
     backup = _loop_backup(bodies, scratch.stored, state.joint_impulses)
     progress = np.zeros(3, np.int64)
-    done, failing = 0, -1
-    while done < n_steps and failing < 0:
+    loop, data = (_plain_contact_loop, 0) if stage is None else (_staged_contact_loop(stage.compiled_command),
+                                                                 stage.compiled_data)  # fmt: skip
+    origin_time, origin_count = float(clock[0]), int(clock[1])
+    done, failing, failing_controller = 0, -1, -1
+    while done < n_steps and failing < 0 and failing_controller < 0:
         try:
-            done, failing, count, needed = _contact_loop(
-                rows, bodies, count, state.joint_impulses, loads, idle, pipeline.buffers(scratch), backup, progress,
-                recording, record_every, params.solver, h, substeps, done, n_steps,
+            done, failing, failing_controller, count, needed = loop(
+                data, model.gravity, rows, bodies, count, state.joint_impulses, loads, idle, pipeline.buffers(scratch),
+                backup, progress, recording, record_every, params.solver, h, substeps, done, n_steps, origin_time,
+                origin_count,
             )  # fmt: skip
         except (ZeroDivisionError, FloatingPointError):  # a kernel divided by an overflowed value
             done, count = int(progress[0]), int(progress[1])
@@ -269,7 +272,7 @@ def _contact_steps(model, state, inputs, params, scratch, h, n_steps, recording,
     for name, stored in zip(CONTACT_FIELDS, scratch.stored, strict=True):
         setattr(state, name, stored[:count].copy())
     advance_clock(state, h, done)
-    return Steps(done, failing)
+    return Steps(done, failing, failing_controller)
 
 
 def _loop_backup(bodies, stored, joint_impulses):
@@ -278,20 +281,29 @@ def _loop_backup(bodies, stored, joint_impulses):
             tuple(np.empty_like(a) for a in joint_impulses))  # fmt: skip
 
 
-@kernel
-def _contact_loop(model_rows, body_state, count, joint_impulses, loads, idle, buffers, backup, progress, rec,
-                  record_every, settings, h, substeps, first, n_steps):  # fmt: skip
-    """Steps ``first..n_steps-1`` of a call, each one ``pipeline.contact_stages``: the state backed up before it and
-    restored on a non-finite value, the motors advanced, a frame recorded when one is due. The applied loads
-    (``loads``) act in step 0 of the call, ``idle`` (none) in the others. The contact state is the first ``count``
-    rows of ``buffers``' stored arrays; each step reads them and stores its own there.
+def _contact_loop(stage, gravity, model_rows, body_state, count, joint_impulses, loads, idle, buffers, backup, progress,
+                  rec, record_every, settings, h, substeps, first, n_steps, origin_time, origin_count):  # fmt: skip
+    """Steps ``first..n_steps-1`` of a call, each one ``pipeline.contact_stages``: before it ``command_stage`` (bound
+    by :func:`kernel_for`) commands the actuators at the step's counted start time and the driven bodies are woken
+    (thrust that holds a body still must not let it sleep); the state is backed up, and restored on a non-finite
+    value; the motors advance and a frame is recorded when one is due. The applied loads (``loads``) act in step 0
+    of the call, ``idle`` (none) in the others. The contact state is the first ``count`` rows of ``buffers``' stored
+    arrays; each step reads them and stores its own there.
 
-    Returns ``(steps_done, failing_body, count, pairs_needed)``: ``pairs_needed`` > 0 when the pair and contact
-    buffers must grow before step ``steps_done`` (nothing of it has run). ``progress`` holds the step running and its
-    contact count, for the caller to restore from ``backup`` when a kernel raises, and counts the steps in which some
-    contacts were found again (``Scratch.steps_found_again``)."""
+    Returns ``(steps_done, failing_body, failing_controller, count, pairs_needed)``: ``pairs_needed`` > 0 when the
+    pair and contact buffers must grow before step ``steps_done`` (nothing of it has run). ``progress`` holds the
+    step running and its contact count, for the caller to restore from ``backup`` when a kernel raises, and counts
+    the steps in which some contacts were found again (``Scratch.steps_found_again``)."""
     bodies, acts, stored = model_rows[0], loads[2], buffers[7]
+    pos, quat, linvel, angmom, sleep_time, sleeping = body_state[:6]
     for step in range(first, n_steps):
+        t = origin_time + (origin_count + step) * h
+        failing_controller = command_stage(stage, gravity, acts, pos, quat, linvel, angmom, t, h)  # noqa: F821
+        if failing_controller >= 0:
+            return step, -1, failing_controller, count, 0
+        for i in range(sleeping.shape[0]):
+            if acts.driven[i]:
+                sleep_time[i], sleeping[i] = 0.0, False
         progress[0], progress[1] = step, count
         _copy_state(body_state, stored, count, joint_impulses, backup[0], backup[1], backup[2])
         contact_state = (stored[0][:count], stored[1][:count], stored[2][:count], stored[3][:count],
@@ -300,11 +312,11 @@ def _contact_loop(model_rows, body_state, count, joint_impulses, loads, idle, bu
         new_count, most = pipeline.contact_stages(model_rows, body_state, contact_state, joint_impulses, step_loads,
                                                   buffers, settings, h, substeps)  # fmt: skip
         if new_count < 0:
-            return step, -1, count, -new_count
+            return step, -1, -1, count, -new_count
         failing = _first_non_finite_body(body_state, bodies.is_dynamic, backup[0])
         if failing >= 0:
             _copy_state(backup[0], backup[1], count, backup[2], body_state, stored, joint_impulses)
-            return step, failing, count, 0
+            return step, failing, -1, count, 0
         count = new_count
         progress[2] += most > 1
         advance_motors(acts, 0, bodies.mass.shape[0], h)
@@ -314,7 +326,7 @@ def _contact_loop(model_rows, body_state, count, joint_impulses, loads, idle, bu
             rec.quat[frame][:] = body_state[1]
             rec.linvel[frame][:] = body_state[2]
             rec.angmom[frame][:] = body_state[3]
-    return n_steps, -1, count, 0
+    return n_steps, -1, -1, count, 0
 
 
 @inline
@@ -368,6 +380,17 @@ def _motion(linvel, angmom, i):
     v, l = load3(linvel, i), load3(angmom, i)
     size = math.sqrt((v[0] * v[0] + v[1] * v[1]) + v[2] * v[2]) + math.sqrt((l[0] * l[0] + l[1] * l[1]) + l[2] * l[2])
     return size if math.isfinite(size) else math.inf
+
+
+# After the helpers it calls: kernel_for copies the module's names as they are when it runs.
+_plain_contact_loop = kernel_for(_contact_loop, "contact_loop", command_stage=_no_stage)
+
+
+@functools.cache
+def _staged_contact_loop(command):
+    """The contact loop with a stage's ``command`` bound in (as :func:`_staged_steps`)."""
+    name = getattr(command, "py_func", command).__name__.strip("_")
+    return kernel_for(_contact_loop, f"contact_loop_{name}", command_stage=command)
 
 
 def _restore(bodies, stored, count, joint_impulses, backup):

@@ -131,9 +131,10 @@ def _compiled_stage(world):
 
 def _simulate_stage(world, stage, dt: float, n_steps: int, recording, record_every: int):
     """The steps with the compiled ``stage`` between them: ``(steps_done, failing_body, error)`` as
-    :func:`_simulate_stepwise`. Free bodies (no sensors, a constant wind) take all the steps in one call; else
-    each step is a call, and the stage one more (instead of a Python controller each)."""
-    if world._model.has_constraints or world._sensors or not isinstance(world._wind, (Constant, type(None))):
+    :func:`_simulate_stepwise`. Without sensors and with a constant wind, all the steps take one call of the runner,
+    the stage compiled into its loop; else each step is a call, and the stage one more (instead of a Python
+    controller each)."""
+    if world._sensors or not isinstance(world._wind, (Constant, type(None))):
         result = _simulate_stepwise(world, dt, n_steps, recording, record_every, stage=stage)
     else:
         state = world._state

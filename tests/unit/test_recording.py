@@ -89,18 +89,18 @@ def test_npz_and_hdf5_round_trip_the_same_arrays_and_metadata(tmp_path):
 def test_a_failed_run_leaves_every_frame_before_the_failing_step(tmp_path, monkeypatch):
     """A step that goes non-finite mid-chunk: the frames of the chunks before it and of the good steps of its
     chunk are in the file, which is closed with status "failed"; the error carries the same frames."""
-    world, loop = _pile(), runner._contact_loop
+    world, loop = _pile(), runner._plain_contact_loop
 
     def fail_at_step_23(*args):
         """The runner's compiled loop, up to the world's step 23, which body 3 fails (the world as before it)."""
-        *head, first, n_steps = args
+        *head, first, n_steps, origin_time, origin_count = args
         stop = 23 - world.step_count  # the call's step that is the world's step 23
         if not first <= stop < n_steps:
             return loop(*args)
-        done, failing, count, needed = loop(*head, first, stop)
-        return (done, failing, count, needed) if failing >= 0 or needed > 0 else (stop, 3, count, 0)
+        done, failing, controller, count, needed = loop(*head, first, stop, origin_time, origin_count)
+        return (done, failing, controller, count, needed) if done < stop or needed > 0 else (stop, 3, -1, count, 0)
 
-    monkeypatch.setattr(runner, "_contact_loop", fail_at_step_23)
+    monkeypatch.setattr(runner, "_plain_contact_loop", fail_at_step_23)
     path = tmp_path / "failed.h5"
     with pytest.raises(tumble.SimulationError, match="box2") as info:
         recording.record(world, 1.0, DT, path, chunk_frames=10)

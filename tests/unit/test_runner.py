@@ -1,5 +1,6 @@
-"""The runner's one compiled loop (``tumble.runner``): free bodies with or without a compiled controller stage, on one
-thread or split over two, back up, restore on a non-finite value and advance the motors alike."""
+"""The runner's compiled loops (``tumble.runner``): free bodies with or without a compiled controller stage, on one
+thread or split over two, and worlds with contacts, back up, restore on a non-finite value and advance the motors
+alike; the contact loop grows its buffers within a call without changing a bit."""
 
 from __future__ import annotations
 
@@ -91,3 +92,66 @@ def test_the_loop_with_a_compiled_stage_is_stamped_with_the_stage_package():
     stamp = staged._cache._impl._locator.get_source_stamp()
     assert stamp == _jit._package_stamp("control") != _jit._package_stamp(None)
     assert runner._plain_steps._cache._impl._locator.get_source_stamp() == _jit._package_stamp(None)
+
+
+def _on_the_ground_with_a_runaway() -> tuple[tumble.World, list]:
+    """A contact world: a box resting on a plane, a body lifted by a rotor that spins up, and a body without shape so
+    fast that its position overflows after about 17 steps of 1 s."""
+    world = tumble.World(gravity=(0, 0, -9.81))
+    world.add_static(tumble.Plane())
+    world.add_body(tumble.Box((0.2, 0.2, 0.2)), mass=1.0, position=(0, 0, 0.1))
+    lifted = world.add_body(None, mass=0.1, inertia=np.eye(3) * 1e-3, position=(3, 0, 1))
+    rotor = world.add_actuator(Rotor(lifted, (0, 0, 0), (0, 0, 1), 1, K_THRUST, K_MOMENT, time_constant=0.05))
+    rotor.command(400.0)
+    world.add_body(None, mass=1.0, inertia=np.eye(3), velocity=(1e307, 0, 0), name="runaway")
+    return world, [rotor]
+
+
+def test_a_contact_world_that_fails_mid_call_keeps_the_steps_before_as_a_step_loop_does():
+    """The compiled loop of contact steps restores the state before the failing step, motors included, and the
+    trajectory holds the frames before it: the same bits as stepping one step a call."""
+    world, rotors = _on_the_ground_with_a_runaway()
+    step, digest, speeds, *_ = _run_until_failure(world, rotors)
+    assert 10 < step < 30
+    stepped, stepped_rotors = _on_the_ground_with_a_runaway()
+    with pytest.raises(tumble.SimulationError, match="runaway") as info:
+        for _ in range(100):
+            stepped.step(1.0)
+    assert info.value.step == step
+    assert stepped.state.digest() == digest
+    assert [r.speed for r in stepped_rotors] == speeds
+
+
+@compiled_only("120 steps of a 30-box pile, twice, and as many one by one")
+def test_contact_buffers_that_grow_within_a_call_give_the_bits_of_steps_one_by_one():
+    """Boxes dropped from rising heights meet the ground and each other one after the other, so the candidate pairs
+    outgrow the buffers several times within one ``simulate``: the loop returns, the buffers grow (keeping the last
+    step's contacts) and it goes on, with the bits of a step a call and of buffers grown beforehand."""
+
+    def pile() -> tumble.World:
+        world = tumble.World()
+        world.add_static(tumble.Plane())
+        for k in range(30):
+            world.add_body(
+                tumble.Box((0.2, 0.2, 0.2)), mass=1.0, position=(0.05 * (k % 3), 0.05 * (k % 2), 0.3 + 0.25 * k)
+            )
+        return world
+
+    called = pile()
+    called.simulate(2.0, 1 / 60)
+    assert called._scratch.manifolds.shape_a.shape[0] >= 8  # grown within the call from room for one pair
+    stepped = pile()
+    for _ in range(120):
+        stepped.step(1 / 60)
+    roomy = pile()
+    roomy.step(1 / 60)
+    roomy._scratch.reserve_contacts(4096)
+    roomy.simulate(119 / 60, 1 / 60)
+    assert called.state.digest() == stepped.state.digest() == roomy.state.digest()
+
+
+@compiled_only("the cache stamps compiled code")
+def test_the_contact_loop_with_a_compiled_stage_is_stamped_with_the_stage_package():
+    staged = runner._staged_contact_loop(native.command_stage)
+    assert staged._cache._impl._locator.get_source_stamp() == _jit._package_stamp("control")
+    assert runner._plain_contact_loop._cache._impl._locator.get_source_stamp() == _jit._package_stamp(None)

@@ -1,9 +1,9 @@
 """Flights in the kernels: when a world's only controllers are ``quad.fly(SE3Controller(...), Hover | Circle |
 Lissajous | MinimumSnap)``, ``world.simulate`` evaluates them with :func:`command_flights`, one kernel call for all
 of them, instead of a Python controller each. :class:`NativeFlights` is the compiled stage the world's controllers
-hand the run to (``tumble.controllers.Controllers.compiled_stage``); a world of free bodies (no contacts or joints,
-no sensors, a constant wind) takes every step and flight in one call of the runner's loop (``tumble.runner``), which
-calls :func:`command_stage` before each step.
+hand the run to (``tumble.controllers.Controllers.compiled_stage``); a world without sensors and with a constant wind
+takes every step and flight in one call of a compiled loop of the runner (``tumble.runner``: free bodies, or contacts
+and joints), which calls :func:`command_stage` before each step.
 
 It does what the step-by-step path does, in the same order and with the same kernels: at each step's counted start
 time the flights that are due evaluate their reference (``reference_derivatives``) and the SE(3) law
