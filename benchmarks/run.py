@@ -13,6 +13,9 @@ Run from the repository root:
 ``pile``, ``pyramid``, ``cubes``, ``big_pyramid``
                  contact scenes, tumble against MuJoCo and PyBullet (``benchmarks/contact.py``); ``big_pyramid``
                  (5050 boxes, tumble only) runs only when asked for with ``--only``.
+``contact_steps``
+                 a box on a plane and the 27-box pile stepped from Python, beside the same steps inside one
+                 ``simulate`` and MuJoCo's ``mj_step`` loop (``benchmarks/contact_steps.py``).
 ``articulation_chain``
                  the 20-link pendulum chain in generalised coordinates (``tumble.Articulation``, RK4 and symplectic)
                  beside MuJoCo's Euler and RK4, 10 s at dt = 1 ms (``benchmarks/articulation.py``).
@@ -73,6 +76,7 @@ from . import (
     broad_phase,
     build,
     contact,
+    contact_steps,
     ensembles,
     envs,
     first_run,
@@ -136,6 +140,7 @@ class Sizes:
     build_bodies: tuple[int, ...] = (1_000, 10_000, 100_000)  # worlds built (benchmarks/build.py)
     build_joints: tuple[int, ...] = (1_000, 10_000)
     broad_phase_shapes: tuple[int, ...] = (1_000, 5_000)  # benchmarks/broad_phase.py
+    contact_step_calls: int = 2000  # steps of the box on a plane (the pile: a tenth) (benchmarks/contact_steps.py)
 
 
 FULL = Sizes()
@@ -145,7 +150,7 @@ QUICK = Sizes(
     pile_seconds=0.2, pyramid_base=4, pyramid_seconds=0.2,
     cubes_boxes=(8, 27), cubes_seconds=0.2, big_pyramid_base=6, big_pyramid_seconds=0.2, chain_links=4,
     chain_seconds=0.2, quadrotor_seconds=0.2, rotorpy_seconds=0.2, build_bodies=(100, 400), build_joints=(100, 400),
-    broad_phase_shapes=(50,),
+    broad_phase_shapes=(50,), contact_step_calls=20,
 )  # fmt: skip
 
 
@@ -745,6 +750,7 @@ BENCHMARKS: dict[str, Callable[[Sizes], list[dict]]] = {
     "many_bodies": bench_many_bodies,
     "cold_start": bench_cold_start,
     "pile": contact.bench_pile,
+    "contact_steps": contact_steps.bench_contact_steps,
     "pyramid": contact.bench_pyramid,
     "cubes": contact.bench_cubes,
     "big_pyramid": contact.bench_big_pyramid,

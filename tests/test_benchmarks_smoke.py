@@ -148,6 +148,18 @@ def test_contact_pile_and_pyramid_rows_for_tumble():
     assert "big_pyramid" in run.OPTIONAL
 
 
+def test_contact_steps_rows_for_both_scenes_and_both_modes():
+    rows = run.BENCHMARKS["contact_steps"](run.QUICK)
+    tumble_rows = [r for r in rows if r["engine"] == "tumble"]
+    assert [(r["scene"], r["mode"]) for r in tumble_rows] == [
+        (scene, mode) for scene in ("box on a plane", "27-box pile") for mode in ("step() loop", "simulate")
+    ]
+    assert all(r["us_per_step"] > 0 for r in rows)
+    assert [r["x_simulate"] for r in tumble_rows if r["mode"] == "simulate"] == [1.0, 1.0]
+    mujoco = [r for r in rows if r["engine"] == "MuJoCo"]
+    assert len(mujoco) == 1 and mujoco[0]["x_mujoco"] == 1.0
+
+
 def test_contact_rows_for_the_peers():
     pytest.importorskip("mujoco")
     pytest.importorskip("pybullet")
