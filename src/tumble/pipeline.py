@@ -5,9 +5,10 @@ Free bodies (nothing can touch) take all the steps of a call at once, body by bo
 
     advance_rows          model.body_*, inputs  -> state.body_*            (dynamics/integrate.py)
 
-Bodies with contacts (the soft step of DESIGN.md), all of it one compiled call (``_step_kernel``): a step enters
-compiled code once, and the runner's compiled loop can take the stages as they are. The narrow phase's loop of every
-pair type is compiled in (one copy for every world, cached on disk; the loops of pair types a world lacks never run):
+Bodies with contacts (the soft step of DESIGN.md), all of it compiled (``contact_stages``) and inlined into the
+runner's compiled loop of steps, which a call of ``World.step`` or ``simulate`` enters once. The narrow phase's loop
+of every pair type is compiled in (one copy for every world, cached on disk; the loops of pair types a world lacks
+never run):
 
     to_angular_velocity   state.body_angmom      -> scratch.body_angvel, body_inv_inertia_world (dynamics/substep.py)
     update_aabbs          state, geometry        -> world bounds           (geometry/broad_phase.py)

@@ -259,7 +259,7 @@ def _contact_steps(model, state, inputs, params, scratch, h, n_steps, recording,
             )  # fmt: skip
         except (ZeroDivisionError, FloatingPointError):  # a kernel divided by an overflowed value
             done, count = int(progress[0]), int(progress[1])
-            _restore(bodies, scratch.stored, count, state.joint_impulses, backup)
+            _copy_state(backup[0], backup[1], count, backup[2], bodies, scratch.stored, state.joint_impulses)
             failing = _fastest_body(backup, model.body_is_dynamic)
         else:
             if needed > 0:  # more candidate pairs than the buffers hold: grow them, keeping the contact rows
@@ -393,21 +393,11 @@ def _staged_contact_loop(command):
     return kernel_for(_contact_loop, f"contact_loop_{name}", command_stage=command)
 
 
-def _restore(bodies, stored, count, joint_impulses, backup):
-    for array, saved in zip(bodies, backup[0], strict=True):
-        np.copyto(array, saved)
-    for array, saved in zip(stored, backup[1], strict=True):
-        array[:count] = saved[:count]
-    for array, saved in zip(joint_impulses, backup[2], strict=True):
-        np.copyto(array, saved)
-
-
 def _fastest_body(backup, is_dynamic: np.ndarray) -> int:
-    """The dynamic body that moved fastest before the step (|v| + |L|), or -1 without one."""
+    """The dynamic body that moved fastest before the step (:func:`_motion` of the backup), or -1 without one."""
     with np.errstate(over="ignore", invalid="ignore"):
-        size = np.linalg.norm(backup[0][2], axis=1) + np.linalg.norm(backup[0][3], axis=1)
-    motion = np.where(is_dynamic, np.where(np.isfinite(size), size, np.inf), -1.0)
-    return int(np.argmax(motion)) if motion.size else -1
+        motion = [_motion(backup[0][2], backup[0][3], i) if is_dynamic[i] else -1.0 for i in range(is_dynamic.shape[0])]
+    return int(np.argmax(motion)) if motion else -1
 
 
 def record_frame(recording: Recording, record_every: int, step: int, state: State) -> None:

@@ -122,8 +122,9 @@ def test_a_contact_world_that_fails_mid_call_keeps_the_steps_before_as_a_step_lo
     assert [r.speed for r in stepped_rotors] == speeds
 
 
-@compiled_only("120 steps of a 30-box pile, twice, and as many one by one")
-def test_contact_buffers_that_grow_within_a_call_give_the_bits_of_steps_one_by_one():
+@compiled_only("2 s of a 30-box pile, twice, and as many steps one by one")
+@pytest.mark.parametrize("hz", [60, 240])
+def test_contact_buffers_that_grow_within_a_call_give_the_bits_of_steps_one_by_one(hz):
     """Boxes dropped from rising heights meet the ground and each other one after the other, so the candidate pairs
     outgrow the buffers several times within one ``simulate``: the loop returns, the buffers grow (keeping the last
     step's contacts) and it goes on, with the bits of a step a call and of buffers grown beforehand."""
@@ -137,16 +138,17 @@ def test_contact_buffers_that_grow_within_a_call_give_the_bits_of_steps_one_by_o
             )
         return world
 
+    dt, steps = 1.0 / hz, 2 * hz
     called = pile()
-    called.simulate(2.0, 1 / 60)
+    called.simulate(steps * dt, dt)
     assert called._scratch.manifolds.shape_a.shape[0] >= 8  # grown within the call from room for one pair
     stepped = pile()
-    for _ in range(120):
-        stepped.step(1 / 60)
+    for _ in range(steps):
+        stepped.step(dt)
     roomy = pile()
-    roomy.step(1 / 60)
+    roomy.step(dt)
     roomy._scratch.reserve_contacts(4096)
-    roomy.simulate(119 / 60, 1 / 60)
+    roomy.simulate((steps - 1) * dt, dt)
     assert called.state.digest() == stepped.state.digest() == roomy.state.digest()
 
 
@@ -155,3 +157,37 @@ def test_the_contact_loop_with_a_compiled_stage_is_stamped_with_the_stage_packag
     staged = runner._staged_contact_loop(native.command_stage)
     assert staged._cache._impl._locator.get_source_stamp() == _jit._package_stamp("control")
     assert runner._plain_contact_loop._cache._impl._locator.get_source_stamp() == _jit._package_stamp(None)
+
+
+def test_a_kernel_that_raises_within_the_contact_loop_leaves_the_state_before_that_step(monkeypatch):
+    """A kernel that divides by an overflowed value raises out of the compiled loop mid-step: the runner restores the
+    backup the loop took before that step (bodies, contact rows, joints) and names the body that was fastest then."""
+    world, _ = _on_the_ground_with_a_runaway()
+    world.step(1.0)
+    before = world.state.copy()
+    loop = runner._plain_contact_loop
+
+    def raise_mid_step(*args):
+        """The loop's own bookkeeping for its first step (the backup and the progress), then a ruined state and the
+        error, as a kernel that raised there would leave them."""
+        body_state, count, joint_impulses, buffers, backup, progress = (
+            args[3],
+            args[4],
+            args[5],
+            args[8],
+            args[9],
+            args[10],
+        )
+        runner._copy_state(body_state, buffers[7], count, joint_impulses, backup[0], backup[1], backup[2])
+        progress[0], progress[1] = args[-4], count
+        for array in (*body_state[:4], *(stored[:count] for stored in buffers[7][4:])):
+            array[...] = np.nan
+        raise ZeroDivisionError("float division by zero")
+
+    monkeypatch.setattr(runner, "_plain_contact_loop", raise_mid_step)
+    with pytest.raises(tumble.SimulationError, match="runaway") as info:
+        world.simulate(3.0, 1.0)
+    assert info.value.step == 1
+    assert world.state.digest() == before.digest()
+    monkeypatch.setattr(runner, "_plain_contact_loop", loop)
+    world.step(1.0)  # and the world steps on from there

@@ -98,7 +98,7 @@ def run_substeps(
     """Substeps ``first`` to ``last - 1`` of the soft step's inner loop (Catto 2024): per substep integrate
     velocities, bounce the ball impacts of the substep, warm start (joints, then contacts), solve with a soft bias,
     integrate positions, relax without bias. The step runs them in one call, or in several where contacts are found
-    again between them (``pipeline.contact_step``); the state between calls is all in the arrays.
+    again between them (``pipeline.contact_stages``); the state between calls is all in the arrays.
     ``inv_mass`` and ``inv_inertia_world`` are zero for bodies that do not move (static or sleeping), which the
     solver then treats as fixed."""
     inv_h = 1.0 / h
