@@ -27,6 +27,7 @@ import numpy as np
 
 from . import pipeline
 from ._jit import inline, kernel_for
+from .compiled_world import compiled_world
 from .dynamics import integrate
 from .dynamics.actuation import ActuatorArrays, advance_motors
 from .dynamics.integrate import Recording, advance_rows
@@ -73,15 +74,15 @@ def simulate_steps(
     """
     if acts is None:
         acts = ActuatorArrays.empty(model.body_count)
+    if recording is None:
+        record_every = 0
     if model.has_constraints:
-        steps = _contact_steps(model, state, inputs, params, scratch, h, n_steps, recording, record_every, acts,
-                               stage, clock)  # fmt: skip
+        steps = _contact_steps(model, state, inputs, params, scratch, acts, recording, h, n_steps, record_every, stage,
+                               clock)  # fmt: skip
     else:
-        if recording is None:
-            recording, record_every = scratch.no_recording, 0
         method = int(params.resolve_integrator(False))
-        steps = _free_body_steps(model, state, inputs, acts, scratch, h, n_steps, method, recording, record_every,
-                                 stage, clock)  # fmt: skip
+        world = compiled_world(model, state, inputs, params, scratch, acts, recording).record
+        steps = _free_body_steps(world, state, acts, scratch, h, n_steps, method, record_every, stage, clock)
         advance_clock(state, h, steps.done)
     # The applied loads act in the first step; one that failed drops them too (the world keeps its state from
     # before it), or a load that makes every step overflow (RK4 sums four stages of it) would leave it stuck.
@@ -98,9 +99,9 @@ def advance_clock(state: State, h: float, steps: int) -> None:
     state.step_count += steps
 
 
-def _free_steps(stage, bodies, gravity, force, torque, acts, pos, quat, linvel, angmom, backup, rec, failed_step, h,
-                n_steps, chunk, method, record_every, first, last, origin_time, origin_count):  # fmt: skip
-    """Bodies ``first..last-1`` through ``n_steps`` steps, ``chunk`` at a time: before each chunk ``command_stage``
+def _free_steps(stage, world, h, n_steps, chunk, method, record_every, first, last, origin_time, origin_count):
+    """Bodies ``first..last-1`` of the ``world`` (a :class:`CompiledWorld`) through ``n_steps`` steps, ``chunk`` at a
+    time: before each chunk ``command_stage``
     (bound by :func:`kernel_for`) commands the actuators at the chunk's counted start time; the rows are backed up,
     advanced (``advance_rows``), and on a non-finite value restored and replayed to the last step all completed; the
     motors of these bodies advance by the chunk. Returns ``(steps_done, failing_body, failing_controller)``, -1 for
@@ -108,6 +109,15 @@ def _free_steps(stage, bodies, gravity, force, torque, acts, pos, quat, linvel, 
 
     The replay goes through the same call of ``advance_rows`` as the chunk: it is compiled into this loop, and a
     second call would compile the integrators twice (5 s more of a cold start)."""
+    bodies, gravity, backup, rec, failed_step = (
+        world.model_rows[0],
+        world.gravity,
+        world.free_backup,
+        world.rec,
+        world.failed_step,
+    )
+    force, torque, acts = world.loads
+    pos, quat, linvel, angmom = world.body_state[0], world.body_state[1], world.body_state[2], world.body_state[3]
     done = 0
     while done < n_steps:
         end = min(done + chunk, n_steps)
@@ -180,24 +190,24 @@ def _staged_steps(command):
     return kernel_for(_free_steps, f"free_steps_{name}", command_stage=command)
 
 
-def _free_body_steps(model, state, inputs, acts, scratch, h, n_steps, method, recording, record_every, stage, clock):
-    """The free bodies' loop: without a stage one chunk of all the steps, split over the threads when the work is
-    large (rows are independent: any split gives the same bits); with one, a chunk a step on this thread."""
-    arrays = (state.body_pos, state.body_quat, state.body_linvel, state.body_angmom)
-    head = (model.body_arrays, model.gravity, inputs.body_force, inputs.body_torque, acts, *arrays, scratch.backup,
-            recording, scratch.failed_step, h)  # fmt: skip
-    tail = (method, record_every)
-    n = model.body_count
+def _free_body_steps(world, state, acts, scratch, h, n_steps, method, record_every, stage, clock):
+    """The free bodies' loop over the ``world`` record: without a stage one chunk of all the steps, split over the
+    threads when the work is large (rows are independent: any split gives the same bits); with one, a chunk a step
+    on this thread."""
+    n = state.body_count
     if stage is not None:
         origin_time, origin_count = clock
-        return Steps(*_staged_steps(stage.compiled_command)(stage.compiled_data, *head, n_steps, 1, *tail, 0, n,
-                                                             float(origin_time), int(origin_count)))  # fmt: skip
+        return Steps(*_staged_steps(stage.compiled_command)(stage.compiled_data, world, h, n_steps, 1, method,
+                                                             record_every, 0, n, float(origin_time),
+                                                             int(origin_count)))  # fmt: skip
     if n * n_steps < integrate.PARALLEL_MIN_WORK or integrate.threads() < 2 or n < 2:
-        return Steps(*_plain_steps(0, *head, n_steps, n_steps, *tail, 0, n, 0.0, 0))
+        return Steps(*_plain_steps(0, world, h, n_steps, n_steps, method, record_every, 0, n, 0.0, 0))
     speeds = acts.speed.copy()
     bounds = np.linspace(0, n, min(integrate.threads(), n) + 1).astype(np.int64)
     futures = [
-        integrate.thread_pool().submit(_plain_steps, 0, *head, n_steps, n_steps, *tail, int(lo), int(hi), 0.0, 0)
+        integrate.thread_pool().submit(
+            _plain_steps, 0, world, h, n_steps, n_steps, method, record_every, int(lo), int(hi), 0.0, 0
+        )  # fmt: skip
         for lo, hi in zip(bounds[:-1], bounds[1:], strict=True)
     ]
     blocks = [Steps(*future.result()) for future in futures]
@@ -205,11 +215,12 @@ def _free_body_steps(model, state, inputs, acts, scratch, h, n_steps, method, re
     if first_failure.failing_body < 0:
         return Steps(n_steps)
     # Every block back to the start, then all the rows on this thread to the last step all of them completed.
+    arrays = (state.body_pos, state.body_quat, state.body_linvel, state.body_angmom)
     for array, saved in zip(arrays, scratch.backup, strict=True):
         np.copyto(array, saved)
     np.copyto(acts.speed, speeds)
     if first_failure.done > 0:
-        _plain_steps(0, *head, first_failure.done, first_failure.done, *tail, 0, n, 0.0, 0)
+        _plain_steps(0, world, h, first_failure.done, first_failure.done, method, record_every, 0, n, 0.0, 0)
     return first_failure
 
 
@@ -225,7 +236,7 @@ def step_by_step(n_steps: int, one_step, recording: Recording, record_every: int
     return Steps(n_steps)
 
 
-def _contact_steps(model, state, inputs, params, scratch, h, n_steps, recording, record_every, acts, stage, clock):
+def _contact_steps(model, state, inputs, params, scratch, acts, recording, h, n_steps, record_every, stage, clock):
     """Soft steps in the compiled loop (:func:`_contact_loop`, with the ``stage``'s command bound in when there is
     one); on a non-finite value the state before that step."""
     if params.resolve_integrator(True) != Integrator.SYMPLECTIC:
@@ -234,18 +245,12 @@ def _contact_steps(model, state, inputs, params, scratch, h, n_steps, recording,
             "bodies are jointed steps with the contact and joint solver: use integrator='auto' or 'symplectic'"
         )
     substeps = params.solver.substeps_for(h)
-    if recording is None:
-        recording, record_every = scratch.no_recording, 0
     # The last step's contacts into the rows the loop reads and writes.
     count = state.contact_count
     scratch.reserve_contacts(count)
+    compiled = compiled_world(model, state, inputs, params, scratch, acts, recording)
     for name, stored in zip(CONTACT_FIELDS, scratch.stored, strict=True):
         stored[:count] = getattr(state, name)
-    rows, bodies = pipeline.model_rows(model), pipeline.body_state(state)
-    loads = (inputs.body_force, inputs.body_torque, acts)
-    idle = (np.zeros_like(inputs.body_force), np.zeros_like(inputs.body_torque), acts)
-    backup = _loop_backup(bodies, scratch.stored, state.joint_impulses)
-    progress = np.zeros(3, np.int64)
     loop, data = (_plain_contact_loop, 0) if stage is None else (_staged_contact_loop(stage.compiled_command),
                                                                  stage.compiled_data)  # fmt: skip
     origin_time, origin_count = float(clock[0]), int(clock[1])
@@ -253,40 +258,35 @@ def _contact_steps(model, state, inputs, params, scratch, h, n_steps, recording,
     while done < n_steps and failing < 0 and failing_controller < 0:
         try:
             done, failing, failing_controller, count, needed = loop(
-                data, model.gravity, rows, bodies, count, state.joint_impulses, loads, idle, pipeline.buffers(scratch),
-                backup, progress, recording, record_every, params.solver, h, substeps, done, n_steps, origin_time,
-                origin_count,
-            )  # fmt: skip
+                data, compiled.record, count, record_every, h, substeps, done, n_steps, origin_time, origin_count
+            )
         except (ZeroDivisionError, FloatingPointError):  # a kernel divided by an overflowed value
+            progress, backup = compiled.progress, compiled.backup
             done, count = int(progress[0]), int(progress[1])
-            _copy_state(backup[0], backup[1], count, backup[2], bodies, scratch.stored, state.joint_impulses)
+            _copy_state(backup[0], backup[1], count, backup[2], pipeline.body_state(state), scratch.stored,
+                        state.joint_impulses)  # fmt: skip
             failing = _fastest_body(backup, model.body_is_dynamic)
         else:
             if needed > 0:  # more candidate pairs than the buffers hold: grow them, keeping the contact rows
                 scratch.reserve_contacts(needed, keep=count)
-                backup = _loop_backup(bodies, scratch.stored, state.joint_impulses)
+                compiled = compiled_world(model, state, inputs, params, scratch, acts, recording)
         if done > 0:
             scratch.joint_step = h
     scratch.contact_count = count
-    scratch.steps_found_again += int(progress[2])
+    scratch.steps_found_again += int(compiled.progress[2])
+    compiled.progress[2] = 0
     for name, stored in zip(CONTACT_FIELDS, scratch.stored, strict=True):
         setattr(state, name, stored[:count].copy())
     advance_clock(state, h, done)
     return Steps(done, failing, failing_controller)
 
 
-def _loop_backup(bodies, stored, joint_impulses):
-    """Room for the state before a step: the body arrays, the contact rows, the joints' impulses."""
-    return (tuple(np.empty_like(a) for a in bodies), tuple(np.empty_like(a) for a in stored),
-            tuple(np.empty_like(a) for a in joint_impulses))  # fmt: skip
-
-
-def _contact_loop(stage, gravity, model_rows, body_state, count, joint_impulses, loads, idle, buffers, backup, progress,
-                  rec, record_every, settings, h, substeps, first, n_steps, origin_time, origin_count):  # fmt: skip
-    """Steps ``first..n_steps-1`` of a call, each one ``pipeline.contact_stages``: before it ``command_stage`` (bound
-    by :func:`kernel_for`) commands the actuators at the step's counted start time and the driven bodies are woken
-    (thrust that holds a body still must not let it sleep); the state is backed up, and restored on a non-finite
-    value; the motors advance and a frame is recorded when one is due. The applied loads (``loads``) act in step 0
+def _contact_loop(stage, world, count, record_every, h, substeps, first, n_steps, origin_time, origin_count):
+    """Steps ``first..n_steps-1`` of a call over the ``world`` (a ``CompiledWorld``), each one
+    ``pipeline.contact_stages``: before it ``command_stage`` (bound by :func:`kernel_for`) commands the actuators at
+    the step's counted start time and the driven bodies are woken (thrust that holds a body still must not let it
+    sleep); the state is backed up, and restored on a non-finite value; the motors advance and a frame is recorded
+    when one is due. The applied loads (``loads``) act in step 0
     of the call, ``idle`` (none) in the others. The contact state is the first ``count`` rows of ``buffers``' stored
     arrays; each step reads them and stores its own there.
 
@@ -294,6 +294,21 @@ def _contact_loop(stage, gravity, model_rows, body_state, count, joint_impulses,
     pair and contact buffers must grow before step ``steps_done`` (nothing of it has run). ``progress`` holds the
     step running and its contact count, for the caller to restore from ``backup`` when a kernel raises, and counts
     the steps in which some contacts were found again (``Scratch.steps_found_again``)."""
+    model_rows, body_state, joint_impulses, buffers = (
+        world.model_rows,
+        world.body_state,
+        world.joint_impulses,
+        world.buffers,
+    )
+    settings = world.settings
+    loads, idle, backup, progress, rec, gravity = (
+        world.loads,
+        world.idle,
+        world.backup,
+        world.progress,
+        world.rec,
+        world.gravity,
+    )
     bodies, acts, stored = model_rows[0], loads[2], buffers[7]
     pos, quat, linvel, angmom, sleep_time, sleeping = body_state[:6]
     for step in range(first, n_steps):

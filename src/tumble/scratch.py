@@ -36,6 +36,9 @@ class Scratch:
         island_parent, island_min_time: (body_count,) union-find work arrays of the sleep pass.
         joint_force_total, joint_moment_total: (joint_count, 3) linear and angular impulses each joint gave its
             body b over the last contact step [N s, N m s]; joint_step: that step's length [s] (0: none yet).
+        compiled: ``(key, compiled_world.Compiled)``: the world's arrays as one compiled object, kept for the next
+            step while the arrays of ``key`` stay the same objects (``compiled_world.compiled_world``); None after the
+            buffers grew.
     """
 
     backup_pos: np.ndarray
@@ -62,6 +65,7 @@ class Scratch:
     joint_force_total: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
     joint_moment_total: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
     joint_step: float = 0.0
+    compiled: tuple | None = None
 
     @classmethod
     def for_world(cls, body_count: int, shape_count: int, joint_count: int = 0) -> Scratch:
@@ -83,7 +87,10 @@ class Scratch:
     def reserve_contacts(self, pair_count: int, keep: int = 0) -> None:
         """Grow the pair and contact buffers to hold one manifold per candidate pair (doubling, never shrinking),
         keeping the first ``keep`` rows of :attr:`stored`."""
+        pairs = self.pairs.a
         self.pairs.reserve(pair_count)
+        if self.pairs.a is not pairs:
+            self.compiled = None  # it holds the buffers replaced
         capacity = self.manifolds.shape_a.shape[0]
         if pair_count > capacity:
             capacity = max(pair_count, 2 * capacity)
@@ -95,6 +102,7 @@ class Scratch:
             self.rows = ContactRows.allocate(capacity)
             self.warm_normal = np.zeros((capacity, MAX_POINTS))
             self.warm_tangent = np.zeros((capacity, MAX_POINTS, 3))
+            self.compiled = None
 
 
 def _stored_contacts(capacity: int) -> tuple[np.ndarray, ...]:

@@ -11,7 +11,7 @@ import pytest
 
 import tumble
 from compiled import compiled_only
-from tumble import _jit, runner
+from tumble import _jit, pipeline, runner
 from tumble.actuators import Rotor, Thruster
 from tumble.control import native
 from tumble.dynamics import integrate
@@ -167,20 +167,15 @@ def test_a_kernel_that_raises_within_the_contact_loop_leaves_the_state_before_th
     before = world.state.copy()
     loop = runner._plain_contact_loop
 
-    def raise_mid_step(*args):
-        """The loop's own bookkeeping for its first step (the backup and the progress), then a ruined state and the
-        error, as a kernel that raised there would leave them."""
-        body_state, count, joint_impulses, buffers, backup, progress = (
-            args[3],
-            args[4],
-            args[5],
-            args[8],
-            args[9],
-            args[10],
-        )
-        runner._copy_state(body_state, buffers[7], count, joint_impulses, backup[0], backup[1], backup[2])
-        progress[0], progress[1] = args[-4], count
-        for array in (*body_state[:4], *(stored[:count] for stored in buffers[7][4:])):
+    def raise_mid_step(stage, record, count, *rest):
+        """The loop's own bookkeeping for its first step (the backup and the progress, in the arrays the world's
+        compiled record shares with the runner), then a ruined state and the error, as a kernel that raised there
+        would leave them."""
+        compiled, stored = world._scratch.compiled[1], world._scratch.stored
+        body_state, joint_impulses = pipeline.body_state(world._state), world._state.joint_impulses
+        runner._copy_state(body_state, stored, count, joint_impulses, *compiled.backup)
+        compiled.progress[0], compiled.progress[1] = rest[-4], count
+        for array in (*body_state[:4], *(rows[:count] for rows in stored[4:])):
             array[...] = np.nan
         raise ZeroDivisionError("float division by zero")
 

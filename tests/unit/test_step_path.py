@@ -9,9 +9,9 @@ import tumble
 
 
 def _calls_of_one_step(world: tumble.World) -> tuple[list[str], list[str]]:
-    """``(stack, visited)``: the tumble modules on the stack when the pipeline is first entered (the runner takes the
-    arrays of its stages from it, then steps in compiled code), outermost first (each once), and every tumble module
-    the step called into."""
+    """``(stack, visited)``: the tumble modules on the stack when ``compiled_world`` is first entered (the runner takes
+    the world's record of arrays from it, then steps in compiled code), outermost first (each once), and every tumble
+    module the step called into."""
     stack: list[str] = []
     visited: set[str] = set()
 
@@ -22,7 +22,7 @@ def _calls_of_one_step(world: tumble.World) -> tuple[list[str], list[str]]:
         if not module.startswith("tumble"):
             return
         visited.add(module)
-        if module == "tumble.pipeline" and not stack:
+        if module == "tumble.compiled_world" and not stack:
             outer = frame
             while outer is not None:
                 name = outer.f_globals.get("__name__", "")
@@ -44,7 +44,7 @@ def test_dt_from_world_step_reaches_the_pipeline_through_the_runner_only():
     world.add_body(tumble.Box((0.1, 0.1, 0.1)), mass=1.0, position=(0.0, 0.0, 0.2))
     world.step(1.0 / 60.0)  # the model built and the kernels loaded before the walk is watched
     stack, visited = _calls_of_one_step(world)
-    assert stack == ["tumble.world", "tumble.world_stepping", "tumble.runner", "tumble.pipeline"]
+    assert stack == ["tumble.world", "tumble.world_stepping", "tumble.runner", "tumble.compiled_world"]
     assert not [m for m in visited if m.split(".")[1] in ("control", "vehicles")]
 
 
@@ -58,7 +58,7 @@ def test_a_world_with_a_flown_quadrotor_steps_through_the_same_walk():
     quad.fly(SE3Controller(quad), Hover((0.0, 0.0, 1.0)))
     world.step(1.0 / 100.0)
     stack, visited = _calls_of_one_step(world)
-    assert stack == ["tumble.world", "tumble.world_stepping", "tumble.runner", "tumble.pipeline"]
+    assert stack == ["tumble.world", "tumble.world_stepping", "tumble.runner", "tumble.compiled_world"]
     assert "tumble.control.fly" in visited  # the flight ran as a controller, before the step
 
 
