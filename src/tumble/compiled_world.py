@@ -85,9 +85,10 @@ def compiled_world(
     since it was built (a check of identities, not of values), else a new one, then kept. With a ``recording`` (a
     ``simulate`` call's frames) a record for the call, sharing all but its frames with the kept one."""
     key = (model, state, inputs, acts, params.solver, *pipeline.body_state(state), *state.joint_impulses)
+    identities = tuple(map(id, key))
     kept = scratch.compiled
-    if kept is None or not _same(kept[0], key):
-        kept = key, _built(model, state, inputs, params, scratch, acts)
+    if kept is None or kept[0] != identities:  # the kept key holds its objects: their ids are not reused meanwhile
+        kept = identities, _built(model, state, inputs, params, scratch, acts), key
         scratch.compiled = kept
     compiled = kept[1]
     if recording is None:
@@ -120,11 +121,3 @@ def _built(model, state, inputs, params, scratch, acts) -> Compiled:
         params.solver,
     )
     return Compiled(_build(*values), values, progress, backup)
-
-
-def _same(kept: tuple, key: tuple) -> bool:
-    """Whether two keys hold the same objects, one for one."""
-    for a, b in zip(kept, key, strict=True):
-        if a is not b:
-            return False
-    return True

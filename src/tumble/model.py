@@ -152,7 +152,7 @@ class Model:
             free[column[column >= 0]] = False
         return free
 
-    @property
+    @cached_property
     def has_constraints(self) -> bool:
         """Whether anything couples bodies (contacts or joints); free-motion integrators apply if not."""
         return self.has_contacts or self.joint_count > 0

@@ -26,7 +26,7 @@ from typing import NamedTuple
 import numpy as np
 
 from . import pipeline
-from ._jit import inline, kernel_for
+from ._jit import inline, kernel, kernel_for
 from .compiled_world import compiled_world
 from .dynamics import integrate
 from .dynamics.actuation import ActuatorArrays, advance_motors
@@ -117,7 +117,10 @@ def _free_steps(stage, world, h, n_steps, chunk, method, record_every, first, la
         world.failed_step,
     )
     force, torque, acts = world.loads
-    pos, quat, linvel, angmom = world.body_state[0], world.body_state[1], world.body_state[2], world.body_state[3]
+    pos, quat, linvel, angmom, sleep_time, sleeping = world.body_state[:6]
+    for i in range(first, last):  # thrust that holds a body still must not let it sleep
+        if acts.driven[i]:
+            sleep_time[i], sleeping[i] = 0.0, False
     done = 0
     while done < n_steps:
         end = min(done + chunk, n_steps)
@@ -200,7 +203,7 @@ def _free_body_steps(world, state, acts, scratch, h, n_steps, method, record_eve
         return Steps(*_staged_steps(stage.compiled_command)(stage.compiled_data, world, h, n_steps, 1, method,
                                                              record_every, 0, n, float(origin_time),
                                                              int(origin_count)))  # fmt: skip
-    if n * n_steps < integrate.PARALLEL_MIN_WORK or integrate.threads() < 2 or n < 2:
+    if n < 2 or n * n_steps < integrate.PARALLEL_MIN_WORK or integrate.threads() < 2:
         return Steps(*_plain_steps(0, world, h, n_steps, n_steps, method, record_every, 0, n, 0.0, 0))
     speeds = acts.speed.copy()
     bounds = np.linspace(0, n, min(integrate.threads(), n) + 1).astype(np.int64)
@@ -245,12 +248,16 @@ def _contact_steps(model, state, inputs, params, scratch, acts, recording, h, n_
             "bodies are jointed steps with the contact and joint solver: use integrator='auto' or 'symplectic'"
         )
     substeps = params.solver.substeps_for(h)
-    # The last step's contacts into the rows the loop reads and writes.
+    # The last step's contacts into the rows the loop reads and writes, unless they are there already: the state
+    # holds the read-only copies of them that the last call left (any other arrays were put there since).
     count = state.contact_count
     scratch.reserve_contacts(count)
     compiled = compiled_world(model, state, inputs, params, scratch, acts, recording)
-    for name, stored in zip(CONTACT_FIELDS, scratch.stored, strict=True):
-        stored[:count] = getattr(state, name)
+    contacts = (state.contact_shape_a, state.contact_shape_b, state.contact_point_count, state.contact_feature,
+                state.contact_normal_impulse, state.contact_tangent_impulse)  # fmt: skip
+    if tuple(map(id, contacts)) != scratch.contacts_left[0]:
+        for stored, array in zip(scratch.stored, contacts, strict=True):
+            stored[:count] = array
     loop, data = (_plain_contact_loop, 0) if stage is None else (_staged_contact_loop(stage.compiled_command),
                                                                  stage.compiled_data)  # fmt: skip
     origin_time, origin_count = float(clock[0]), int(clock[1])
@@ -275,10 +282,22 @@ def _contact_steps(model, state, inputs, params, scratch, acts, recording, h, n_
     scratch.contact_count = count
     scratch.steps_found_again += int(compiled.progress[2])
     compiled.progress[2] = 0
-    for name, stored in zip(CONTACT_FIELDS, scratch.stored, strict=True):
-        setattr(state, name, stored[:count].copy())
+    contacts = _contact_copies(compiled.record, count)
+    for name, array in zip(CONTACT_FIELDS, contacts, strict=True):
+        array.flags.writeable = False
+        setattr(state, name, array)
+    scratch.contacts_left = tuple(map(id, contacts)), contacts  # the arrays held: their ids are not reused meanwhile
     advance_clock(state, h, done)
     return Steps(done, failing, failing_controller)
+
+
+@kernel
+def _contact_copies(world, count):
+    """Copies of the first ``count`` rows of the stored contact arrays (``buffers[7]``, in the order of
+    ``CONTACT_FIELDS``): the state's contacts after a call. One call, not six slices and six copies in Python."""
+    stored = world.buffers[7]
+    return (stored[0][:count].copy(), stored[1][:count].copy(), stored[2][:count].copy(), stored[3][:count].copy(),
+            stored[4][:count].copy(), stored[5][:count].copy())  # fmt: skip
 
 
 def _contact_loop(stage, world, count, record_every, h, substeps, first, n_steps, origin_time, origin_count):

@@ -36,9 +36,11 @@ class Scratch:
         island_parent, island_min_time: (body_count,) union-find work arrays of the sleep pass.
         joint_force_total, joint_moment_total: (joint_count, 3) linear and angular impulses each joint gave its
             body b over the last contact step [N s, N m s]; joint_step: that step's length [s] (0: none yet).
-        compiled: ``(key, compiled_world.Compiled)``: the world's arrays as one compiled object, kept for the next
-            step while the arrays of ``key`` stay the same objects (``compiled_world.compiled_world``); None after the
-            buffers grew.
+        compiled: ``(identities, compiled_world.Compiled, key)``: the world's arrays as one compiled object, kept for
+            the next step while the objects of ``key`` stay the same (``compiled_world.compiled_world``); None after
+            the buffers grew.
+        contacts_left: ``(ids, arrays)``: the read-only ``State.contact_*`` arrays the last contact call left, copies
+            of the first rows of :attr:`stored` (while the state holds them, the next call need not copy them back).
     """
 
     backup_pos: np.ndarray
@@ -66,6 +68,7 @@ class Scratch:
     joint_moment_total: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
     joint_step: float = 0.0
     compiled: tuple | None = None
+    contacts_left: tuple = ((), ())
 
     @classmethod
     def for_world(cls, body_count: int, shape_count: int, joint_count: int = 0) -> Scratch:

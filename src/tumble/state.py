@@ -117,6 +117,8 @@ class State:
 
     def with_joints(self, joint_count: int) -> None:
         """Append zero impulses for joints added since (rows of existing joints are kept)."""
+        if self.joint_drive_impulse.shape[0] == joint_count:  # before every step: the usual case costs one check
+            return
         for name, width in zip(_JOINT_FIELDS, _JOINT_WIDTHS, strict=True):
             old = getattr(self, name)
             if old.shape[0] < joint_count:

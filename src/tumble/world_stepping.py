@@ -40,21 +40,24 @@ def checked_step(world, dt) -> float:
 
 def _controlled_step(world, dt: float, stage=None) -> int:
     """The controllers that are due (or the compiled ``stage`` in their place), one step, the sensors' samples:
-    the failing body's row, or -1.
+    the failing body's row, or -1. A part the world lacks costs a check, not a call.
 
     Raises:
         SimulationError: a controller raised (before the step: the world is as it was).
     """
-    if stage is None:
-        world._controllers.run(world, _next_step_time(world, dt), dt)
-    else:
+    if stage is not None:
         stage.command(world._model, world._state, world._actuation.arrays, _next_step_time(world, dt), dt)
-    world._sync()
-    world._sensors.before_step(world)
+        world._sync()
+    elif world._controllers:
+        world._controllers.run(world, _next_step_time(world, dt), dt)
+        world._sync()  # a controller may have added bodies
+    sensors = world._sensors
+    if sensors:
+        sensors.before_step(world)
     failing = simulate_steps(world._model, world._state, world._inputs, world._params, world._scratch, dt,
                              acts=_actuators_for_step(world, dt)).failing_body  # fmt: skip
-    if failing < 0:
-        world._sensors.sample(world, dt)
+    if failing < 0 and sensors:
+        sensors.sample(world, dt)
     return failing
 
 
@@ -63,19 +66,16 @@ def _next_step_time(world, dt: float) -> float:
     return world._clock.start_of_next_step(world._state.time, world._state.step_count, dt)
 
 
+_CALM = np.zeros(3)
+_CALM.flags.writeable = False
+
+
 def _actuators_for_step(world, dt: float):
-    """The actuators' arrays and the wind for the next steps; their bodies are kept awake (thrust that holds a
-    body still must not let it sleep, or a change of wind or command would not reach it)."""
-    if world._wind is not None:
-        world._actuation.wind = world._wind.velocity(_next_step_time(world, dt), dt)
-    else:
-        world._actuation.wind = np.zeros(3)
-    acts = world._actuation.for_bodies(world._model.body_com_local)
-    driven = world._actuation.driven_bodies()
-    if driven.size:
-        world._state.body_sleep_time[driven] = 0.0
-        world._state.body_sleeping[driven] = False
-    return acts
+    """The actuators' arrays with the wind for the next steps (the runner's loops keep their bodies awake: thrust that
+    holds a body still must not let it sleep, or a change of wind or command would not reach it)."""
+    actuation = world._actuation
+    actuation.wind = _CALM if world._wind is None else world._wind.velocity(_next_step_time(world, dt), dt)
+    return actuation.for_bodies(world._model.body_com_local)
 
 
 def simulate(world, duration: float, dt: float, record_every: int = 1) -> Trajectory:

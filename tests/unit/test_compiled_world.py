@@ -1,0 +1,128 @@
+"""A world's arrays as one compiled record (issue 46, part 1): built once, kept while nothing it holds is replaced,
+built again after every change, and a step over a kept record equals one over a record built afresh."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import tumble
+from tumble.actuators import Thruster
+
+DT = 1.0 / 60.0
+
+
+def _record(world: tumble.World):
+    return world._scratch.compiled[1].record
+
+
+def _ground_with_a_box() -> tumble.World:
+    world = tumble.World()
+    world.add_static(tumble.Plane())
+    world.add_body(tumble.Box((0.4, 0.3, 0.2)), mass=1.0, position=(0.0, 0.0, 0.5), angular_velocity=(0.3, 0.2, 1.0))
+    return world
+
+
+def _changes():
+    """``(name, change)``: every kind of change a world sees between steps, as a user makes it."""
+
+    def add_body(world):
+        world.add_body(tumble.Sphere(0.1), mass=0.5, position=(0.6, 0.0, 0.4), velocity=(-1.0, 0.0, 0.0))
+
+    def add_joint(world):
+        world.add_joint(tumble.BallJoint(world.bodies[-1], None, anchor=world.bodies[-1].position + (0.0, 0.0, 0.3)))
+
+    def add_thruster(world):
+        world.add_actuator(Thruster(world.bodies[-1], (0.0, 0.0, 0.0), (0.0, 0.0, 1.0), max_force=10.0)).command(3.0)
+
+    def set_solver(world):
+        world.set_solver(substeps=12, contact_hertz=40.0)
+
+    def assign_state(world):
+        saved = world.state.copy()
+        world.step(DT)
+        world.state.assign(saved)
+
+    def set_gravity(world):
+        world.gravity = (0.0, 1.0, -9.81)
+
+    return [add_body, add_joint, add_thruster, set_solver, assign_state, set_gravity]
+
+
+def _run(fresh_each_step: bool) -> list[str]:
+    """The digests after each change and the steps that follow it; with ``fresh_each_step`` the kept record is
+    dropped before every step, so that each step builds its own."""
+    world = _ground_with_a_box()
+    digests = []
+    for change in [None, *_changes()]:
+        if change is not None:
+            change(world)
+        for _ in range(5):
+            if fresh_each_step:
+                world._scratch.compiled = None
+            world.step(DT)
+        digests.append(world.state.digest())
+    return digests
+
+
+def test_a_kept_record_steps_as_a_record_built_afresh_for_each_step_through_every_kind_of_change():
+    assert _run(fresh_each_step=False) == _run(fresh_each_step=True)
+
+
+@pytest.mark.parametrize("change", _changes(), ids=lambda change: change.__name__)
+def test_every_change_builds_the_record_again_and_plain_steps_keep_it(change):
+    world = _ground_with_a_box()
+    world.step(DT)
+    kept = _record(world)
+    world.step(DT)
+    assert _record(world) is kept  # nothing changed: the same record
+    if change.__name__ == "add_joint":  # a joint needs a body of its own to hold
+        _changes()[0](world)
+        world.step(DT)
+        kept = _record(world)
+    change(world)
+    world.step(DT)
+    assert _record(world) is not kept
+
+
+def test_a_static_body_added_later_gives_the_world_that_had_it_from_the_start():
+    """Out of reach of everything, the wall changes nothing before or after it is added: the world that gets it after
+    20 steps matches bit for bit, at every later step, the one built with it."""
+
+    def wall(world):
+        world.add_static(tumble.Box((0.2, 4.0, 4.0)), position=(50.0, 0.0, 2.0))
+
+    late, early = _ground_with_a_box(), _ground_with_a_box()
+    wall(early)
+    for _ in range(20):
+        late.step(DT)
+        early.step(DT)
+    wall(late)
+    for _ in range(30):
+        late.step(DT)
+        early.step(DT)
+        assert late.state.digest() == early.state.digest()
+
+
+def test_the_states_contact_arrays_are_read_only_copies_and_a_replaced_one_is_what_the_next_step_reads():
+    """The next step reads its warm start from the rows it left, unless the state's arrays were replaced: then from
+    them (an equal copy steps the same, a changed one differently)."""
+
+    def settled():
+        world = _ground_with_a_box()
+        for _ in range(30):
+            world.step(DT)
+        return world
+
+    world = settled()
+    assert world.state.contact_count > 0
+    with pytest.raises(ValueError, match="read-only"):
+        world.state.contact_normal_impulse[...] = 0.0
+    reference, same, changed = settled(), settled(), settled()
+    same.state.contact_normal_impulse = same.state.contact_normal_impulse.copy()
+    changed.state.contact_normal_impulse = 3.0 * changed.state.contact_normal_impulse
+    for w in (reference, same, changed):
+        w.step(DT)
+    assert same.state.digest() == reference.state.digest()
+    assert changed.state.digest() != reference.state.digest()
+    np.testing.assert_array_equal(same.state.contact_normal_impulse, reference.state.contact_normal_impulse)
