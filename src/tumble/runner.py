@@ -26,7 +26,7 @@ from typing import NamedTuple
 import numpy as np
 
 from . import pipeline
-from ._jit import inline, kernel, kernel_for
+from ._jit import inline, kernel_for
 from .compiled_world import compiled_world
 from .dynamics import integrate
 from .dynamics.actuation import ActuatorArrays, advance_motors
@@ -248,16 +248,18 @@ def _contact_steps(model, state, inputs, params, scratch, acts, recording, h, n_
             "bodies are jointed steps with the contact and joint solver: use integrator='auto' or 'symplectic'"
         )
     substeps = params.solver.substeps_for(h)
-    # The last step's contacts into the rows the loop reads and writes, unless they are there already: the state
-    # holds the read-only copies of them that the last call left (any other arrays were put there since).
+    # The last step's contacts into the rows the loop reads and writes, unless the state holds the views of those
+    # rows that the last call left (any other arrays were put there since).
     count = state.contact_count
     scratch.reserve_contacts(count)
     compiled = compiled_world(model, state, inputs, params, scratch, acts, recording)
+    stored = scratch.stored
     contacts = (state.contact_shape_a, state.contact_shape_b, state.contact_point_count, state.contact_feature,
                 state.contact_normal_impulse, state.contact_tangent_impulse)  # fmt: skip
-    if tuple(map(id, contacts)) != scratch.contacts_left[0]:
-        for stored, array in zip(scratch.stored, contacts, strict=True):
-            stored[:count] = array
+    held = tuple(map(id, contacts)) == scratch.contacts_left[0]
+    if not held:
+        for rows, array in zip(stored, contacts, strict=True):
+            rows[:count] = array
     loop, data = (_plain_contact_loop, 0) if stage is None else (_staged_contact_loop(stage.compiled_command),
                                                                  stage.compiled_data)  # fmt: skip
     origin_time, origin_count = float(clock[0]), int(clock[1])
@@ -282,22 +284,13 @@ def _contact_steps(model, state, inputs, params, scratch, acts, recording, h, n_
     scratch.contact_count = count
     scratch.steps_found_again += int(compiled.progress[2])
     compiled.progress[2] = 0
-    contacts = _contact_copies(compiled.record, count)
-    for name, array in zip(CONTACT_FIELDS, contacts, strict=True):
-        array.flags.writeable = False
-        setattr(state, name, array)
-    scratch.contacts_left = tuple(map(id, contacts)), contacts  # the arrays held: their ids are not reused meanwhile
+    if not held or count != state.contact_count or scratch.stored is not stored:
+        views = tuple(rows[:count] for rows in scratch.stored)
+        for name, view in zip(CONTACT_FIELDS, views, strict=True):
+            setattr(state, name, view)
+        scratch.contacts_left = tuple(map(id, views)), views  # the views held: their ids are not reused meanwhile
     advance_clock(state, h, done)
     return Steps(done, failing, failing_controller)
-
-
-@kernel
-def _contact_copies(world, count):
-    """Copies of the first ``count`` rows of the stored contact arrays (``buffers[7]``, in the order of
-    ``CONTACT_FIELDS``): the state's contacts after a call. One call, not six slices and six copies in Python."""
-    stored = world.buffers[7]
-    return (stored[0][:count].copy(), stored[1][:count].copy(), stored[2][:count].copy(), stored[3][:count].copy(),
-            stored[4][:count].copy(), stored[5][:count].copy())  # fmt: skip
 
 
 def _contact_loop(stage, world, count, record_every, h, substeps, first, n_steps, origin_time, origin_count):

@@ -39,8 +39,8 @@ class Scratch:
         compiled: ``(identities, compiled_world.Compiled, key)``: the world's arrays as one compiled object, kept for
             the next step while the objects of ``key`` stay the same (``compiled_world.compiled_world``); None after
             the buffers grew.
-        contacts_left: ``(ids, arrays)``: the read-only ``State.contact_*`` arrays the last contact call left, copies
-            of the first rows of :attr:`stored` (while the state holds them, the next call need not copy them back).
+        contacts_left: ``(ids, arrays)``: the ``State.contact_*`` arrays the last contact call left, views of the
+            first rows of :attr:`stored` (while the state holds them, the next call need not copy them back).
     """
 
     backup_pos: np.ndarray

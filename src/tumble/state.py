@@ -7,7 +7,8 @@ velocity, is the state (as in the course's state vector ``(x, A, p, L)``): with 
 constant. ``Body.angular_velocity`` computes ``ω = R I⁻¹ Rᵀ L``.
 
 The ``contact_*`` arrays are the impulses of the last step's contact points, kept to warm-start the next
-step; they are sorted by shape pair and change size every step. The ``joint_*`` arrays are the joints'
+step; they are sorted by shape pair and change size every step. After a step they are views of the rows the next
+step reads and overwrites, as the body arrays are (``copy()`` keeps a snapshot). The ``joint_*`` arrays are the joints'
 accumulated impulses, one row per joint, kept for the same reason.
 """
 
