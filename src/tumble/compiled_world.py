@@ -84,7 +84,8 @@ def compiled_world(
     """The record of these arrays: the one kept in ``scratch`` while none of the arrays it holds has been replaced
     since it was built (a check of identities, not of values), else a new one, then kept. With a ``recording`` (a
     ``simulate`` call's frames) a record for the call, sharing all but its frames with the kept one."""
-    key = (model, state, inputs, acts, params.solver, *pipeline.body_state(state), *state.joint_impulses)
+    key = (model, state, inputs, inputs.body_force, inputs.body_torque, acts, params.solver,
+           *pipeline.body_state(state), *state.joint_impulses)  # fmt: skip
     identities = tuple(map(id, key))
     kept = scratch.compiled
     if kept is None or kept[0] != identities:  # the kept key holds its objects: their ids are not reused meanwhile

@@ -46,7 +46,14 @@ def _changes():
     def set_gravity(world):
         world.gravity = (0.0, 1.0, -9.81)
 
-    return [add_body, add_joint, add_thruster, set_solver, assign_state, set_gravity]
+    def replace_state_array(world):
+        world.state.body_linvel = world.state.body_linvel + (0.0, 0.0, 1.0)
+
+    def replace_inputs_array(world):
+        world.inputs.body_force = np.full_like(world.inputs.body_force, 2.0)
+
+    return [add_body, add_joint, add_thruster, set_solver, assign_state, set_gravity, replace_state_array,
+            replace_inputs_array]  # fmt: skip
 
 
 def _run(fresh_each_step: bool) -> list[str]:
