@@ -18,7 +18,7 @@ REPO = Path(__file__).resolve().parent.parent
 if str(REPO) not in sys.path:
     sys.path.insert(0, str(REPO))
 
-from benchmarks import build, contact_steps, joints, peers, quadrotor, run  # noqa: E402
+from benchmarks import build, contact_steps, joints, peers, quadrotor, run, step_breakdown  # noqa: E402
 
 TINY = run.Sizes(
     tumbling_steps=40, record_every=10, bodies=8, body_steps=5, mujoco_seconds=0.002, repeat=1,
@@ -167,6 +167,14 @@ def test_contact_steps_rows_for_every_scene_and_both_modes():
     if importlib.util.find_spec("mujoco") is not None:
         assert [r["scene"] for r in mujoco] == scene_names and all(r["x_mujoco"] == 1.0 for r in mujoco)
         assert all("x_mujoco" in r for r in tumble_rows)
+
+
+def test_the_step_breakdown_splits_each_call_into_its_parts():
+    rows = step_breakdown.breakdown()
+    assert [r["scene"] for r in rows] == ["one free body", "box on a plane"]
+    for row in rows:
+        assert 0 < row["simulate_us"] < row["step_us"] and 0 < row["entry_us"] < row["step_us"]
+        assert row["python_us"] == pytest.approx(row["step_us"] - row["simulate_us"] - row["entry_us"])
 
 
 def test_contact_rows_for_the_peers():
