@@ -70,6 +70,11 @@ class Scratch:
     compiled: tuple | None = None
     contacts_left: tuple = ((), ())
 
+    def __getstate__(self) -> dict:
+        """A copy or a pickle without the compiled record (a Numba object that neither copies nor pickles, and would
+        hold the original's arrays) and without the ids of the state's contact views: the copy builds its own."""
+        return {**self.__dict__, "compiled": None, "contacts_left": ((), ())}
+
     @classmethod
     def for_world(cls, body_count: int, shape_count: int, joint_count: int = 0) -> Scratch:
         scratch = cls(

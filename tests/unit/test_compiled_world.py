@@ -3,6 +3,9 @@ built again after every change, and a step over a kept record equals one over a 
 
 from __future__ import annotations
 
+import copy
+import pickle
+
 import numpy as np
 import pytest
 
@@ -132,3 +135,21 @@ def test_the_states_contact_arrays_are_what_the_next_step_reads_written_in_place
     assert same.state.digest() == reference.state.digest()
     assert written.state.digest() == replaced.state.digest() != reference.state.digest()
     np.testing.assert_array_equal(same.state.contact_normal_impulse, reference.state.contact_normal_impulse)
+
+
+@pytest.mark.parametrize("duplicate", [copy.deepcopy, lambda world: pickle.loads(pickle.dumps(world))],
+                         ids=["deepcopy", "pickle"])  # fmt: skip
+def test_a_stepped_world_copies_and_pickles_and_the_copy_steps_on_as_the_original(duplicate):
+    """The record is not part of a copy (it would hold the original's arrays): the copy builds its own, and steps on
+    bit for bit as the original, which its steps leave alone."""
+    world = _ground_with_a_box()
+    for _ in range(30):
+        world.step(DT)
+    twin = duplicate(world)
+    before = world.state.digest()
+    for _ in range(10):
+        twin.step(DT)
+    assert world.state.digest() == before
+    for _ in range(10):
+        world.step(DT)
+    assert twin.state.digest() == world.state.digest()
