@@ -17,6 +17,7 @@ import numpy as np
 
 __all__ = [
     "MAX_COUNT",
+    "all_finite",
     "MAX_STEPS",
     "MIN_STEP",
     "as_count",
@@ -176,9 +177,22 @@ def as_array(name: str, value, trailing_shape: tuple[int, ...], *, batch: bool =
     if not shape_ok or (not batch and array.ndim != k):
         expected = ("(..., " if batch else "(") + ", ".join(map(str, trailing_shape)) + ")"
         raise ValueError(f"{name} must have shape {expected}, got shape {array.shape}: {_show(array)}")
-    if not np.isfinite(array).all():
+    if not all_finite(array):
         raise ValueError(f"{name} must be finite, got {_show(array)}")
     return array
+
+
+_SMALL = 64  # elements: up to here a Python sum of the list is cheaper than NumPy's ufunc and reduction
+
+
+def all_finite(array: np.ndarray) -> bool:
+    """Whether every element of a float array is finite. A small array is summed first (0.1–0.3 µs where
+    ``np.isfinite(a).all()`` costs 0.9 µs, before every step of a controller that passes ``tau``): a NaN or an
+    infinity makes the sum non-finite, so a finite sum proves them all finite; a sum that overflowed is checked
+    element by element."""
+    if array.size <= _SMALL and math.isfinite(sum(array.ravel().tolist())):
+        return True
+    return bool(np.isfinite(array).all())
 
 
 # Vectors whose norm lies in this range have squares well inside float range (so do their components).

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._validate import _show, as_array, as_count, as_step, require_memory
+from .._validate import _show, all_finite, as_array, as_count, as_step, require_memory
 from ..dynamics.integrate import thread_pool, threads
 from ..errors import SimulationError
 from .articulation import Articulation, _check_integrator, unit_quaternions
@@ -128,7 +128,7 @@ class ArticulationBatch:
         dt = as_step("dt", dt, self.time)
         steps = as_count("steps", steps)
         method = _check_integrator(integrator)
-        if not np.isfinite(self._tau).all():
+        if not all_finite(self._tau):
             bad = np.argwhere(~np.isfinite(self._tau))[0]
             raise ValueError(f"tau[{bad[0]}, {bad[1]}] must be finite, got {float(self._tau[tuple(bad)])!r}")
         self._advance(dt, steps, method)
