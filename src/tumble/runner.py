@@ -100,12 +100,12 @@ def advance_clock(state: State, h: float, steps: int) -> None:
 
 
 def _free_steps(stage, world, h, n_steps, chunk, method, record_every, first, last, origin_time, origin_count):
-    """Bodies ``first..last-1`` of the ``world`` (a :class:`CompiledWorld`) through ``n_steps`` steps, ``chunk`` at a
-    time: before each chunk ``command_stage``
-    (bound by :func:`kernel_for`) commands the actuators at the chunk's counted start time; the rows are backed up,
-    advanced (``advance_rows``), and on a non-finite value restored and replayed to the last step all completed; the
-    motors of these bodies advance by the chunk. Returns ``(steps_done, failing_body, failing_controller)``, -1 for
-    none. The applied loads ``force``, ``torque`` act in step 0. Releases the GIL (``nogil``).
+    """Bodies ``first..last-1`` of the ``world`` (a ``CompiledWorld``) through ``n_steps`` steps, ``chunk`` at a
+    time: before each chunk ``command_stage`` (bound by :func:`kernel_for`) commands the actuators at the chunk's
+    counted start time; the rows are backed up, advanced (``advance_rows``), and on a non-finite value restored and
+    replayed to the last step all completed; the motors of these bodies advance by the chunk; the driven bodies are
+    woken first. Returns ``(steps_done, failing_body, failing_controller)``, -1 for none. The applied loads
+    (``world.loads``) act in step 0. Releases the GIL (``nogil``).
 
     The replay goes through the same call of ``advance_rows`` as the chunk: it is compiled into this loop, and a
     second call would compile the integrators twice (5 s more of a cold start)."""
@@ -254,8 +254,7 @@ def _contact_steps(model, state, inputs, params, scratch, acts, recording, h, n_
     scratch.reserve_contacts(count)
     compiled = compiled_world(model, state, inputs, params, scratch, acts, recording)
     stored = scratch.stored
-    contacts = (state.contact_shape_a, state.contact_shape_b, state.contact_point_count, state.contact_feature,
-                state.contact_normal_impulse, state.contact_tangent_impulse)  # fmt: skip
+    contacts = state.contact_arrays
     held = tuple(map(id, contacts)) == scratch.contacts_left[0]
     if not held:
         for rows, array in zip(stored, contacts, strict=True):
@@ -298,9 +297,9 @@ def _contact_loop(stage, world, count, record_every, h, substeps, first, n_steps
     ``pipeline.contact_stages``: before it ``command_stage`` (bound by :func:`kernel_for`) commands the actuators at
     the step's counted start time and the driven bodies are woken (thrust that holds a body still must not let it
     sleep); the state is backed up, and restored on a non-finite value; the motors advance and a frame is recorded
-    when one is due. The applied loads (``loads``) act in step 0
-    of the call, ``idle`` (none) in the others. The contact state is the first ``count`` rows of ``buffers``' stored
-    arrays; each step reads them and stores its own there.
+    when one is due. The applied loads (``world.loads``) act in step 0 of the call, ``world.idle`` (none) in the
+    others. The contact state is the first ``count`` rows of the stored arrays (``world.buffers[7]``); each step
+    reads them and stores its own there.
 
     Returns ``(steps_done, failing_body, failing_controller, count, pairs_needed)``: ``pairs_needed`` > 0 when the
     pair and contact buffers must grow before step ``steps_done`` (nothing of it has run). ``progress`` holds the

@@ -131,6 +131,12 @@ class State:
         return self.joint_linear_impulse, self.joint_angular_impulse, self.joint_drive_impulse
 
     @property
+    def contact_arrays(self) -> tuple[np.ndarray, ...]:
+        """The ``contact_*`` arrays in the order of :data:`CONTACT_FIELDS`."""
+        return (self.contact_shape_a, self.contact_shape_b, self.contact_point_count, self.contact_feature,
+                self.contact_normal_impulse, self.contact_tangent_impulse)  # fmt: skip
+
+    @property
     def body_count(self) -> int:
         return int(self.body_pos.shape[0])
 
