@@ -14,7 +14,7 @@ import dataclasses
 import numpy as np
 
 from .model import Model
-from .state import State
+from .state import CONTACT_FIELDS, JOINT_FIELDS, State
 
 __all__ = ["rows_model", "tiled_impulses", "copy_impulses", "splice_contacts", "DRIVE_TARGET"]
 
@@ -27,9 +27,6 @@ _PER_SHAPE = (
     "shape_aabb_half_local", "shape_vertex_start", "shape_vertex_count", "shape_face_start", "shape_face_count",
     "shape_edge_start", "shape_edge_count",
 )  # fmt: skip
-_CONTACT_FIELDS = ("contact_shape_a", "contact_shape_b", "contact_point_count", "contact_feature",
-                   "contact_normal_impulse", "contact_tangent_impulse")  # fmt: skip
-_JOINT_FIELDS = ("joint_linear_impulse", "joint_angular_impulse", "joint_drive_impulse")
 
 
 def _tiled(array: np.ndarray, k: int) -> np.ndarray:
@@ -92,10 +89,10 @@ def rows_model(base: Model, tables: dict[str, np.ndarray], *, fold_gravity: bool
 
 def tiled_impulses(state: State, template: State, k: int, shapes: int) -> None:
     """Give ``state`` (``k`` copies' rows) the template's contacts and joint impulses in every copy."""
-    for name in _JOINT_FIELDS:
+    for name in JOINT_FIELDS:
         setattr(state, name, _tiled(getattr(template, name), k))
     count = template.contact_count
-    for name in _CONTACT_FIELDS:
+    for name in CONTACT_FIELDS:
         setattr(state, name, _tiled(getattr(template, name), k))
     for name in ("contact_shape_a", "contact_shape_b"):
         getattr(state, name)[:] += _offsets(k, shapes, count)
@@ -107,10 +104,10 @@ def splice_contacts(state: State, copies: np.ndarray, template: State | None, sh
     if shapes == 0:
         return
     keep = ~np.isin(state.contact_shape_a // shapes, copies)
-    parts = {name: [getattr(state, name)[keep]] for name in _CONTACT_FIELDS}
+    parts = {name: [getattr(state, name)[keep]] for name in CONTACT_FIELDS}
     if template is not None and template.contact_count and copies.size:
         count = template.contact_count
-        for name in _CONTACT_FIELDS:
+        for name in CONTACT_FIELDS:
             parts[name].append(_tiled(getattr(template, name), copies.size))
         for name in ("contact_shape_a", "contact_shape_b"):
             parts[name][-1] = parts[name][-1] + np.repeat(copies * shapes, count)
@@ -123,9 +120,9 @@ def splice_contacts(state: State, copies: np.ndarray, template: State | None, sh
 
 def copy_impulses(state: State, j: int, shapes: int, joints: int) -> dict[str, np.ndarray]:
     """Local copy ``j``'s contacts and joint impulses in ``state``, numbered as in one world."""
-    out = {name: getattr(state, name)[j * joints : (j + 1) * joints].copy() for name in _JOINT_FIELDS}
+    out = {name: getattr(state, name)[j * joints : (j + 1) * joints].copy() for name in JOINT_FIELDS}
     mine = state.contact_shape_a // shapes == j if shapes else np.zeros(state.contact_count, bool)
-    for name in _CONTACT_FIELDS:
+    for name in CONTACT_FIELDS:
         out[name] = getattr(state, name)[mine].copy()
     out["contact_shape_a"] -= j * shapes
     out["contact_shape_b"] -= j * shapes

@@ -11,6 +11,7 @@ setting changed, a state assigned, the contact buffers grown (:func:`compiled_wo
 
 from __future__ import annotations
 
+import operator
 from typing import NamedTuple
 
 import numpy as np
@@ -23,9 +24,9 @@ from .inputs import Inputs
 from .model import Model
 from .params import Params
 from .scratch import Scratch
-from .state import State
+from .state import BODY_FIELDS, JOINT_FIELDS, State
 
-__all__ = ["Compiled", "CompiledWorld", "compiled_world"]
+__all__ = ["Compiled", "CompiledWorld", "compiled_world", "held", "same_objects"]
 
 _FIELDS = (
     "gravity",  # (3,) the model's gravity
@@ -72,6 +73,21 @@ class Compiled(NamedTuple):
     backup: tuple
 
 
+# The state's arrays a record holds, read in one call (a step checks them: any may have been assigned anew).
+_STATE_ARRAYS = operator.attrgetter(*BODY_FIELDS, *JOINT_FIELDS)
+
+
+def held(model: Model, state: State, inputs: Inputs, params: Params, acts: ActuatorArrays) -> tuple:
+    """The objects a record is built from: while each is the same object (not just equal), the record holds the
+    world's arrays."""
+    return (model, state, inputs, inputs.body_force, inputs.body_torque, acts, params.solver, *_STATE_ARRAYS(state))
+
+
+def same_objects(these: tuple, those: tuple) -> bool:
+    """Whether the tuples hold the same objects, one by one (identities: arrays are never compared by value)."""
+    return all(map(operator.is_, these, those))
+
+
 def compiled_world(
     model: Model,
     state: State,
@@ -81,15 +97,13 @@ def compiled_world(
     acts: ActuatorArrays,
     recording: Recording | None = None,
 ) -> Compiled:
-    """The record of these arrays: the one kept in ``scratch`` while none of the arrays it holds has been replaced
-    since it was built (a check of identities, not of values), else a new one, then kept. With a ``recording`` (a
-    ``simulate`` call's frames) a record for the call, sharing all but its frames with the kept one."""
-    key = (model, state, inputs, inputs.body_force, inputs.body_torque, acts, params.solver,
-           *pipeline.body_state(state), *state.joint_impulses)  # fmt: skip
-    identities = tuple(map(id, key))
+    """The record of these arrays: the one kept in ``scratch`` while the objects it was built from are the same
+    (:func:`held`), else a new one, then kept. With a ``recording`` (a ``simulate`` call's frames) a record for the
+    call, sharing all but its frames with the kept one."""
+    objects = held(model, state, inputs, params, acts)
     kept = scratch.compiled
-    if kept is None or kept[0] != identities:  # the kept key holds its objects: their ids are not reused meanwhile
-        kept = identities, _built(model, state, inputs, params, scratch, acts), key
+    if kept is None or not same_objects(objects, kept[0]):
+        kept = objects, _built(model, state, inputs, params, scratch, acts)
         scratch.compiled = kept
     compiled = kept[1]
     if recording is None:

@@ -27,7 +27,7 @@ import numpy as np
 
 from . import pipeline
 from ._jit import inline, kernel_for
-from .compiled_world import compiled_world
+from .compiled_world import compiled_world, held, same_objects
 from .dynamics import integrate
 from .dynamics.actuation import ActuatorArrays, advance_motors
 from .dynamics.integrate import Recording, advance_rows
@@ -38,7 +38,7 @@ from .params import Integrator, Params
 from .scratch import Scratch
 from .state import CONTACT_FIELDS, State
 
-__all__ = ["Steps", "advance_clock", "record_frame", "simulate_steps", "step_by_step"]
+__all__ = ["ReadyStep", "Steps", "advance_clock", "record_frame", "simulate_steps", "step_by_step"]
 
 
 class Steps(NamedTuple):
@@ -225,6 +225,49 @@ def _free_body_steps(world, state, acts, scratch, h, n_steps, method, record_eve
     if first_failure.done > 0:
         _plain_steps(0, world, h, first_failure.done, first_failure.done, method, record_every, 0, n, 0.0, 0)
     return first_failure
+
+
+class ReadyStep:
+    """One step of free bodies as :func:`simulate_steps` takes it (no recording, no stage), prepared once for the
+    steps that follow: a call of the compiled loop over the kept record, the clock advanced and the loads cleared,
+    and nothing else. ``World.step`` takes it while it :meth:`fits`; anything else the step reads (controllers,
+    sensors, the wind) is the caller's to check.
+
+    It is made (:meth:`of`) only for worlds whose shapes cannot touch and whose bodies are not jointed, and too small
+    to be split over threads in one step."""
+
+    __slots__ = ("_objects", "_integrator", "_record", "_method", "_bodies", "_state", "_inputs")
+
+    def __init__(self, model: Model, state: State, inputs: Inputs, params: Params, scratch: Scratch,
+                 acts: ActuatorArrays):  # fmt: skip
+        self._objects = held(model, state, inputs, params, acts)
+        self._integrator = params.integrator
+        self._record = compiled_world(model, state, inputs, params, scratch, acts).record
+        self._method = int(params.resolve_integrator(False))
+        self._bodies = state.body_count
+        self._state, self._inputs = state, inputs
+
+    @classmethod
+    def of(cls, model: Model, state: State, inputs: Inputs, params: Params, scratch: Scratch,
+           acts: ActuatorArrays) -> ReadyStep | None:  # fmt: skip
+        """The prepared step of these arrays, or None where one step takes more than the loop of free bodies on
+        this thread."""
+        if model.has_constraints or state.body_count >= integrate.PARALLEL_MIN_WORK:
+            return None
+        return cls(model, state, inputs, params, scratch, acts)
+
+    def fits(self, model: Model, state: State, inputs: Inputs, params: Params, acts: ActuatorArrays) -> bool:
+        """Whether these are the objects it was prepared from (the integrator's name too): then its record holds
+        them."""
+        return params.integrator is self._integrator and same_objects(held(model, state, inputs, params, acts),
+                                                                      self._objects)  # fmt: skip
+
+    def __call__(self, h: float) -> int:
+        """One step of ``h``: the row of the body that became non-finite (the arrays as they were), or -1."""
+        done, failing, _ = _plain_steps(0, self._record, h, 1, 1, self._method, 0, 0, self._bodies, 0.0, 0)
+        advance_clock(self._state, h, done)
+        self._inputs.clear()  # as simulate_steps: the loads act in this step, or are dropped with it
+        return failing
 
 
 def step_by_step(n_steps: int, one_step, recording: Recording, record_every: int, state: State) -> Steps:

@@ -36,9 +36,11 @@ class Scratch:
         island_parent, island_min_time: (body_count,) union-find work arrays of the sleep pass.
         joint_force_total, joint_moment_total: (joint_count, 3) linear and angular impulses each joint gave its
             body b over the last contact step [N s, N m s]; joint_step: that step's length [s] (0: none yet).
-        compiled: ``(identities, compiled_world.Compiled, key)``: the world's arrays as one compiled object, kept for
-            the next step while the objects of ``key`` stay the same (``compiled_world.compiled_world``); None after
-            the buffers grew.
+        compiled: ``(objects, compiled_world.Compiled)``: the world's arrays as one compiled object, kept for the
+            next step while the ``objects`` it was built from stay the same (``compiled_world.compiled_world``); None
+            after the buffers grew.
+        ready: the ``World.step`` of a world without Python parts, prepared (``runner.ReadyStep``); None until a step
+            made it, and after anything it does not check changed.
         contacts_left: ``(ids, arrays)``: the ``State.contact_*`` arrays the last contact call left, views of the
             first rows of :attr:`stored` (while the state holds them, the next call need not copy them back).
     """
@@ -68,12 +70,14 @@ class Scratch:
     joint_moment_total: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
     joint_step: float = 0.0
     compiled: tuple | None = None
+    ready: object | None = None
     contacts_left: tuple = ((), ())
 
     def __getstate__(self) -> dict:
         """A copy or a pickle without the compiled record (a Numba object that neither copies nor pickles, and would
-        hold the original's arrays) and without the ids of the state's contact views: the copy builds its own."""
-        return {**self.__dict__, "compiled": None, "contacts_left": ((), ())}
+        hold the original's arrays), the prepared step holding it, and the ids of the state's contact views: the copy
+        builds its own."""
+        return {**self.__dict__, "compiled": None, "ready": None, "contacts_left": ((), ())}
 
     @classmethod
     def for_world(cls, body_count: int, shape_count: int, joint_count: int = 0) -> Scratch:
@@ -98,7 +102,7 @@ class Scratch:
         pairs = self.pairs.a
         self.pairs.reserve(pair_count)
         if self.pairs.a is not pairs:
-            self.compiled = None  # it holds the buffers replaced
+            self.compiled = self.ready = None  # they hold the buffers replaced
         capacity = self.manifolds.shape_a.shape[0]
         if pair_count > capacity:
             capacity = max(pair_count, 2 * capacity)
@@ -110,7 +114,7 @@ class Scratch:
             self.rows = ContactRows.allocate(capacity)
             self.warm_normal = np.zeros((capacity, MAX_POINTS))
             self.warm_tangent = np.zeros((capacity, MAX_POINTS, 3))
-            self.compiled = None
+            self.compiled = self.ready = None
 
 
 def _stored_contacts(capacity: int) -> tuple[np.ndarray, ...]:

@@ -21,9 +21,9 @@ import numpy as np
 
 from .geometry.manifold import MAX_POINTS
 
-__all__ = ["CONTACT_FIELDS", "State"]
+__all__ = ["BODY_FIELDS", "CONTACT_FIELDS", "JOINT_FIELDS", "State"]
 
-_BODY_FIELDS = (
+BODY_FIELDS = (
     "body_pos",
     "body_quat",
     "body_linvel",
@@ -41,10 +41,10 @@ CONTACT_FIELDS = (
     "contact_tangent_impulse",
 )
 
-_JOINT_FIELDS = ("joint_linear_impulse", "joint_angular_impulse", "joint_drive_impulse")
+JOINT_FIELDS = ("joint_linear_impulse", "joint_angular_impulse", "joint_drive_impulse")
 _JOINT_WIDTHS = (3, 3, 5)
 # Fields replaced (not written in place) when they change size: contacts every step, joints when added.
-_SIZED_FIELDS = CONTACT_FIELDS + _JOINT_FIELDS
+_SIZED_FIELDS = CONTACT_FIELDS + JOINT_FIELDS
 
 
 def _no_contacts() -> dict[str, np.ndarray]:
@@ -112,7 +112,7 @@ class State:
         """A new state with rows appended for new bodies (awake, at the given poses and momenta)."""
         new = State.empty(len(pos))
         new.body_pos[:], new.body_quat[:], new.body_linvel[:], new.body_angmom[:] = pos, quat, linvel, angmom
-        arrays = {f: np.concatenate([getattr(self, f), getattr(new, f)]) for f in _BODY_FIELDS}
+        arrays = {f: np.concatenate([getattr(self, f), getattr(new, f)]) for f in BODY_FIELDS}
         kept = {f: getattr(self, f) for f in _SIZED_FIELDS}  # shapes and joints are only appended: rows stay valid
         return State(**arrays, **kept, time=self.time, step_count=self.step_count)
 
@@ -120,7 +120,7 @@ class State:
         """Append zero impulses for joints added since (rows of existing joints are kept)."""
         if self.joint_drive_impulse.shape[0] == joint_count:  # before every step: the usual case costs one check
             return
-        for name, width in zip(_JOINT_FIELDS, _JOINT_WIDTHS, strict=True):
+        for name, width in zip(JOINT_FIELDS, _JOINT_WIDTHS, strict=True):
             old = getattr(self, name)
             if old.shape[0] < joint_count:
                 setattr(self, name, np.concatenate([old, np.zeros((joint_count - old.shape[0], width))]))
@@ -145,12 +145,12 @@ class State:
         return int(self.contact_shape_a.shape[0])
 
     def copy(self) -> State:
-        arrays = {f: getattr(self, f).copy() for f in _BODY_FIELDS + _SIZED_FIELDS}
+        arrays = {f: getattr(self, f).copy() for f in BODY_FIELDS + _SIZED_FIELDS}
         return State(**arrays, time=self.time, step_count=self.step_count)
 
     def assign(self, other: State) -> None:
         """Overwrite this state with ``other``: body arrays in place (views held by users stay valid)."""
-        for f in _BODY_FIELDS:
+        for f in BODY_FIELDS:
             np.copyto(getattr(self, f), getattr(other, f))
         for f in _SIZED_FIELDS:
             setattr(self, f, getattr(other, f).copy())
@@ -165,7 +165,7 @@ class State:
     def digest(self) -> str:
         """sha256 over the arrays (fixed field order), the time and the step count."""
         h = hashlib.sha256()
-        for f in _BODY_FIELDS + _SIZED_FIELDS:
+        for f in BODY_FIELDS + _SIZED_FIELDS:
             array = getattr(self, f)
             h.update(str(array.shape).encode())
             h.update(np.ascontiguousarray(array).tobytes())
@@ -174,4 +174,4 @@ class State:
         return h.hexdigest()
 
     def body_arrays(self) -> dict[str, np.ndarray]:
-        return {f: getattr(self, f) for f in _BODY_FIELDS}
+        return {f: getattr(self, f) for f in BODY_FIELDS}

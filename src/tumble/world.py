@@ -243,6 +243,7 @@ class World:
         tick ``k / rate``; what it commands holds until its next call. ``t`` is the step's start time, counted as
         steps of ``dt`` (see ``tumble.control``). Returns a handle with ``.remove()``. A controller that raises
         stops ``step``/``simulate`` with a :class:`SimulationError` naming it and the time."""
+        self._scratch.ready = None  # the prepared step (world_stepping.step) runs no controllers
         return self._controllers.add(callback, rate, name)
 
     def add_actuator(self, actuator: Actuator) -> Actuator:
@@ -304,6 +305,7 @@ class World:
     def add_sensor(self, sensor: Sensor) -> Sensor:
         """Add a :class:`~tumble.sensors.IMU` or :class:`~tumble.sensors.Pose`; returns it, to ``read()``. It samples
         at the end of every step."""
+        self._scratch.ready = None  # nor sensors
         return self._sensors.add(self, sensor)
 
     @property
@@ -321,6 +323,7 @@ class World:
     @wind.setter
     def wind(self, value) -> None:
         self._wind = as_wind(value)
+        self._scratch.ready = None  # as a controller or sensor added: the next step takes the path that runs it
 
     def attach(self, attachment) -> None:
         """Register ``attachment``, an object that plugs into this world's step through its public interface (a

@@ -1,0 +1,199 @@
+"""``World.step``'s lean path (issue 46, part 2): a world without controllers, sensors or wind takes the step its last
+one prepared (``runner.ReadyStep``): ``dt`` checked, the objects compared, one compiled call. It must step as the
+full path does through every change a user makes between steps, and fail as it does."""
+
+from __future__ import annotations
+
+import copy
+import pickle
+
+import numpy as np
+import pytest
+
+import tumble
+from tumble.actuators import Thruster
+from tumble.errors import SimulationError
+from tumble.sensors import IMU
+
+
+def _spinning_bodies() -> tumble.World:
+    """Two free bodies (their shapes collide with nothing), spinning about no principal axis."""
+    world = tumble.World()
+    world.add_body(tumble.Box((0.4, 0.3, 0.2)), mass=1.0, position=(0.0, 0.0, 1.0), angular_velocity=(0.3, 2.0, 1.0),
+                   collision_mask=0)  # fmt: skip
+    world.add_body(tumble.Cylinder(0.1, 0.5), mass=2.0, position=(1.0, 0.0, 1.0), velocity=(0.5, 0.0, 3.0),
+                   angular_velocity=(4.0, 0.1, -0.3), collision_mask=0)  # fmt: skip
+    return world
+
+
+def _changes():
+    """``(name, change)``: every kind of change a world of free bodies sees between steps, as a user makes it;
+    ``None`` marks a change that leaves a Python part (a controller, a sensor, a wind) until the next one."""
+    parts = {}
+
+    def apply_force(world):
+        world.bodies[0].apply_force((3.0, 0.0, 1.0), point=(0.0, 0.1, 1.0))
+
+    def add_body(world):
+        world.add_body(tumble.Sphere(0.1), mass=0.5, position=(0.6, 0.0, 0.4), velocity=(-1.0, 0.0, 0.0),
+                       collision_mask=0)  # fmt: skip
+
+    def add_thruster(world):
+        world.add_actuator(Thruster(world.bodies[-1], (0.0, 0.0, 0.0), (0.0, 0.0, 1.0), max_force=10.0)).command(3.0)
+
+    def change_integrator(world):
+        world.integrator = "symplectic"
+
+    def change_it_back(world):
+        world.integrator = "auto"
+
+    def set_gravity(world):
+        world.gravity = (0.0, 1.0, -9.81)
+
+    def assign_state(world):
+        world.state.assign(world.state.copy())
+
+    def replace_state_array(world):
+        world.state.body_linvel = world.state.body_linvel + (0.0, 0.0, 1.0)
+
+    def replace_inputs_array(world):
+        world.inputs.body_force = np.full_like(world.inputs.body_force, 2.0)
+
+    def write_state_in_place(world):
+        world.state.body_angmom[1] *= 1.5
+
+    def add_controller(world):
+        parts["controller"] = world.add_controller(lambda w, t: w.bodies[1].apply_torque((0.0, 0.2, 0.0)))
+
+    def remove_controller(world):
+        parts.pop("controller").remove()
+
+    def add_drag_and_wind(world):
+        world.add_drag(world.bodies[0], (0.3, 0.3, 0.3))
+        world.wind = (4.0, 0.0, 0.0)
+
+    def calm_the_wind(world):
+        world.wind = None
+
+    def add_sensor(world):
+        parts["imu"] = world.add_sensor(IMU(world.bodies[1]))
+
+    return [apply_force, add_body, add_thruster, change_integrator, change_it_back, set_gravity, assign_state,
+            replace_state_array, replace_inputs_array, write_state_in_place, add_controller, remove_controller,
+            add_drag_and_wind, calm_the_wind, add_sensor], parts  # fmt: skip
+
+
+def _run(dt: float, full_path: bool) -> list:
+    """The digests after each change and the steps that follow it, and the IMU's last reading; with ``full_path`` the
+    prepared step is dropped before every step."""
+    world = _spinning_bodies()
+    changes, parts = _changes()
+    seen = []
+    for change in [None, *changes]:
+        if change is not None:
+            change(world)
+        for _ in range(max(5, round(1.0 / (12.0 * dt)))):
+            if full_path:
+                world._scratch.ready = None
+            world.step(dt)
+        seen.append(world.state.digest())
+    seen.append(np.concatenate(parts["imu"].read()).tobytes())
+    return seen
+
+
+@pytest.mark.parametrize("hertz", [60, 240, 1000])
+def test_the_prepared_step_steps_as_the_full_path_through_every_change(hertz):
+    assert _run(1.0 / hertz, False) == _run(1.0 / hertz, True)
+
+
+def test_a_world_keeps_its_prepared_step_until_it_changes_and_prepares_another_after():
+    world = _spinning_bodies()
+    assert world._scratch.ready is None
+    world.step(0.01)
+    ready = world._scratch.ready
+    assert ready is not None
+    for _ in range(3):
+        world.bodies[0].apply_force((1.0, 0.0, 0.0))  # loads and in-place writes are read through, not changes
+        world.state.body_pos[1, 2] += 0.01
+        world.step(0.01)
+        assert world._scratch.ready is ready
+    changes, _ = _changes()
+    for change in changes:
+        change(world)
+        world.step(0.01)
+        has_python_parts = bool(world.controllers or world.sensors or world.wind is not None)
+        if has_python_parts:
+            assert world._scratch.ready is None, change.__name__
+        elif change.__name__ not in ("apply_force", "write_state_in_place"):
+            assert world._scratch.ready is not ready, change.__name__
+        ready = world._scratch.ready
+
+
+def test_a_controller_added_after_the_step_was_prepared_runs_at_the_next_step():
+    world = _spinning_bodies()
+    world.step(0.01)
+    calls = []
+    world.add_controller(lambda w, t: calls.append(t))
+    world.step(0.01)
+    world.step(0.01)
+    assert calls == [0.01, 0.02]
+
+
+def test_the_applied_loads_act_in_one_prepared_step_only():
+    world, full = _spinning_bodies(), _spinning_bodies()
+    world.step(0.01)
+    full.step(0.01)
+    for other in (world, full):
+        other.bodies[0].apply_force((0.0, 0.0, 50.0))
+    world.step(0.01)
+    full._scratch.ready = None
+    full.step(0.01)
+    assert world.state.digest() == full.state.digest()
+    assert not world.inputs.body_force.any()
+    v = world.bodies[0].velocity
+    world.step(0.01)
+    np.testing.assert_allclose(world.bodies[0].velocity - v, (0.0, 0.0, -9.81 * 0.01), atol=1e-12)
+
+
+@pytest.mark.parametrize("dt", [float("nan"), float("inf"), -0.01, 0.0, 1e-300, "0.01", None])
+def test_bad_steps_get_the_full_paths_errors_and_move_nothing(dt):
+    world = _spinning_bodies()
+    world.step(0.01)
+    assert world._scratch.ready is not None
+    before = world.state.digest()
+    with pytest.raises((ValueError, TypeError)) as prepared:
+        world.step(dt)
+    full = _spinning_bodies()
+    full.step(0.01)
+    full._scratch.ready = None
+    with pytest.raises(type(prepared.value)) as unprepared:
+        full.step(dt)
+    assert str(prepared.value) == str(unprepared.value) and "dt" in str(prepared.value)
+    assert world.state.digest() == before
+
+
+def test_a_step_that_overflows_keeps_the_world_and_drops_its_loads():
+    world = _spinning_bodies()
+    world.step(0.01)
+    before = world.state.digest()
+    world.bodies[1].apply_force((1e308, 1e308, 0.0))
+    with pytest.raises(SimulationError, match="body #1 became non-finite .* in step 1") as error:
+        world.step(0.01)
+    assert error.value.body == 1 and error.value.step == 1
+    assert world.state.digest() == before and not world.inputs.body_force.any()
+    world.step(0.01)
+    assert world.step_count == 2 and np.isfinite(world.state.body_pos).all()
+
+
+@pytest.mark.parametrize("duplicate", [copy.deepcopy, lambda world: pickle.loads(pickle.dumps(world))],
+                         ids=["deepcopy", "pickle"])  # fmt: skip
+def test_a_copy_of_a_world_with_a_prepared_step_steps_its_own_arrays(duplicate):
+    world = _spinning_bodies()
+    world.step(0.01)
+    other = duplicate(world)
+    assert other._scratch.ready is None
+    for _ in range(3):
+        world.step(0.01)
+        other.step(0.01)
+    assert other.state.digest() == world.state.digest()
+    assert not np.shares_memory(other.state.body_pos, world.state.body_pos)
