@@ -228,13 +228,10 @@ def _free_body_steps(world, state, acts, scratch, h, n_steps, method, record_eve
 
 
 class ReadyStep:
-    """One step of free bodies as :func:`simulate_steps` takes it (no recording, no stage), prepared once for the
-    steps that follow: a call of the compiled loop over the kept record, the clock advanced and the loads cleared,
-    and nothing else. ``World.step`` takes it while it :meth:`fits`; anything else the step reads (controllers,
-    sensors, the wind) is the caller's to check.
-
-    It is made (:meth:`of`) only for worlds whose shapes cannot touch and whose bodies are not jointed, and too small
-    to be split over threads in one step."""
+    """One step as :func:`simulate_steps` takes it (no recording, no stage), prepared once for the steps that
+    follow: a call of the compiled loop over the kept record, the clock advanced and the loads cleared, and little
+    else. ``World.step`` takes it while it :meth:`fits`; anything else the step reads (controllers, sensors, the
+    wind) is the caller's to check. This class steps free bodies; :class:`_ReadyContactStep` contacts and joints."""
 
     __slots__ = ("_objects", "_integrator", "_record", "_method", "_bodies", "_state", "_inputs")
 
@@ -250,9 +247,10 @@ class ReadyStep:
     @classmethod
     def of(cls, model: Model, state: State, inputs: Inputs, params: Params, scratch: Scratch,
            acts: ActuatorArrays) -> ReadyStep | None:  # fmt: skip
-        """The prepared step of these arrays, or None where one step takes more than the loop of free bodies on
-        this thread."""
-        if model.has_constraints or state.body_count >= integrate.PARALLEL_MIN_WORK:
+        """The prepared step of these arrays, or None where one step of free bodies is split over threads."""
+        if model.has_constraints:
+            return _ReadyContactStep(model, state, inputs, params, scratch, acts)
+        if state.body_count >= integrate.PARALLEL_MIN_WORK:
             return None
         return cls(model, state, inputs, params, scratch, acts)
 
@@ -267,6 +265,46 @@ class ReadyStep:
         done, failing, _ = _plain_steps(0, self._record, h, 1, 1, self._method, 0, 0, self._bodies, 0.0, 0)
         advance_clock(self._state, h, done)
         self._inputs.clear()  # as simulate_steps: the loads act in this step, or are dropped with it
+        return failing
+
+
+class _ReadyContactStep(ReadyStep):
+    """One soft step (:func:`_contact_loop`) prepared: the substeps found again only for a new ``h``; the contact
+    rows stay where the last step left them, while the state holds their views (:meth:`fits`). A step that must grow
+    the contact buffers takes the full path."""
+
+    __slots__ = ("_parts", "_scratch", "_progress", "_backup", "_h", "_substeps")
+
+    def __init__(self, model: Model, state: State, inputs: Inputs, params: Params, scratch: Scratch,
+                 acts: ActuatorArrays):  # fmt: skip
+        super().__init__(model, state, inputs, params, scratch, acts)
+        compiled = scratch.compiled[1]
+        self._parts = model, params, acts
+        self._scratch, self._progress, self._backup = scratch, compiled.progress, compiled.backup
+        self._h, self._substeps = math.nan, 0
+
+    def fits(self, model: Model, state: State, inputs: Inputs, params: Params, acts: ActuatorArrays) -> bool:
+        return super().fits(model, state, inputs, params, acts) and _views_held(state, self._scratch)
+
+    def __call__(self, h: float) -> int:
+        if h != self._h:  # a ValueError before anything moved, as the full path's
+            self._substeps, self._h = self._parts[1].solver.substeps_for(h), h
+        scratch, state = self._scratch, self._state
+        count = scratch.contact_count
+        try:
+            done, failing, _, count, needed = _plain_contact_loop(0, self._record, count, 0, h, self._substeps, 0, 1,
+                                                                  0.0, 0)  # fmt: skip
+        except (ZeroDivisionError, FloatingPointError):  # a kernel divided by an overflowed value
+            done, count, failing = _restored(self._progress, self._backup, state, scratch, self._parts[0])
+        else:
+            if needed > 0:  # nothing of the step ran: the full path grows the buffers and takes it
+                model, params, acts = self._parts
+                return simulate_steps(model, state, self._inputs, params, scratch, h, acts=acts).failing_body
+        if done > 0:
+            scratch.joint_step = h
+        _leave_contacts(state, scratch, count, self._progress, True)
+        advance_clock(state, h, done)
+        self._inputs.clear()
         return failing
 
 
@@ -297,10 +335,9 @@ def _contact_steps(model, state, inputs, params, scratch, acts, recording, h, n_
     scratch.reserve_contacts(count)
     compiled = compiled_world(model, state, inputs, params, scratch, acts, recording)
     stored = scratch.stored
-    contacts = state.contact_arrays
-    held = tuple(map(id, contacts)) == scratch.contacts_left[0]
+    held = _views_held(state, scratch)
     if not held:
-        for rows, array in zip(stored, contacts, strict=True):
+        for rows, array in zip(stored, state.contact_arrays, strict=True):
             rows[:count] = array
     loop, data = (_plain_contact_loop, 0) if stage is None else (_staged_contact_loop(stage.compiled_command),
                                                                  stage.compiled_data)  # fmt: skip
@@ -312,27 +349,44 @@ def _contact_steps(model, state, inputs, params, scratch, acts, recording, h, n_
                 data, compiled.record, count, record_every, h, substeps, done, n_steps, origin_time, origin_count
             )
         except (ZeroDivisionError, FloatingPointError):  # a kernel divided by an overflowed value
-            progress, backup = compiled.progress, compiled.backup
-            done, count = int(progress[0]), int(progress[1])
-            _copy_state(backup[0], backup[1], count, backup[2], pipeline.body_state(state), scratch.stored,
-                        state.joint_impulses)  # fmt: skip
-            failing = _fastest_body(backup, model.body_is_dynamic)
+            done, count, failing = _restored(compiled.progress, compiled.backup, state, scratch, model)
         else:
             if needed > 0:  # more candidate pairs than the buffers hold: grow them, keeping the contact rows
                 scratch.reserve_contacts(needed, keep=count)
                 compiled = compiled_world(model, state, inputs, params, scratch, acts, recording)
         if done > 0:
             scratch.joint_step = h
+    _leave_contacts(state, scratch, count, compiled.progress, held and scratch.stored is stored)
+    advance_clock(state, h, done)
+    return Steps(done, failing, failing_controller)
+
+
+def _views_held(state: State, scratch: Scratch) -> bool:
+    """Whether the state's contact arrays are the views of the stored rows that the last contact call left."""
+    return tuple(map(id, state.contact_arrays)) == scratch.contacts_left[0]
+
+
+def _restored(progress, backup, state: State, scratch: Scratch, model: Model) -> tuple[int, int, int]:
+    """After a kernel raised mid-step: the state as it was before that step (the compiled record's ``backup``), and
+    ``(steps_done, contact_count, failing_body)``."""
+    done, count = int(progress[0]), int(progress[1])
+    _copy_state(backup[0], backup[1], count, backup[2], pipeline.body_state(state), scratch.stored,
+                state.joint_impulses)  # fmt: skip
+    return done, count, _fastest_body(backup, model.body_is_dynamic)
+
+
+def _leave_contacts(state: State, scratch: Scratch, count: int, progress: np.ndarray, views_held: bool) -> None:
+    """After a contact call: its contact count and the steps it found contacts again in, into ``scratch``; the
+    state's contact arrays the views of the ``count`` rows stored, made again unless it holds them already."""
     scratch.contact_count = count
-    scratch.steps_found_again += int(compiled.progress[2])
-    compiled.progress[2] = 0
-    if not held or count != state.contact_count or scratch.stored is not stored:
+    if progress[2]:
+        scratch.steps_found_again += int(progress[2])
+        progress[2] = 0
+    if not views_held or count != state.contact_count:
         views = tuple(rows[:count] for rows in scratch.stored)
         for name, view in zip(CONTACT_FIELDS, views, strict=True):
             setattr(state, name, view)
         scratch.contacts_left = tuple(map(id, views)), views  # the views held: their ids are not reused meanwhile
-    advance_clock(state, h, done)
-    return Steps(done, failing, failing_controller)
 
 
 def _contact_loop(stage, world, count, record_every, h, substeps, first, n_steps, origin_time, origin_count):

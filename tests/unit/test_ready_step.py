@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 import tumble
+from tumble import scenes
 from tumble.actuators import Thruster
 from tumble.errors import SimulationError
 from tumble.sensors import IMU
@@ -197,3 +198,95 @@ def test_a_copy_of_a_world_with_a_prepared_step_steps_its_own_arrays(duplicate):
         other.step(0.01)
     assert other.state.digest() == world.state.digest()
     assert not np.shares_memory(other.state.body_pos, world.state.body_pos)
+
+
+# --- contacts and joints: the prepared soft step ----------------------------------------------------------------
+
+
+def _contact_changes():
+    """Changes of a world with contacts between steps; the last ones add a Python part."""
+
+    def add_touching_body(world):
+        world.add_body(tumble.Sphere(0.1), mass=0.5, position=(0.5, 0.0, 0.15), velocity=(-1.0, 0.0, 0.0))
+
+    def set_solver(world):
+        world.set_solver(substeps=12, contact_hertz=40.0)
+
+    def assign_state(world):
+        world.state.assign(world.state.copy())
+
+    def replace_contact_impulses(world):
+        world.state.contact_normal_impulse = 0.5 * world.state.contact_normal_impulse
+
+    def push(world):
+        world.bodies[1].apply_force((30.0, 0.0, 0.0), point=world.bodies[1].position + (0.0, 0.0, 0.1))
+
+    def add_joint(world):
+        world.add_joint(tumble.BallJoint(world.bodies[-1], None, anchor=world.bodies[-1].position + (0.0, 0.0, 0.3)))
+
+    def add_sensor(world):
+        world.add_sensor(IMU(world.bodies[1]))
+
+    return [push, add_touching_body, set_solver, assign_state, replace_contact_impulses, add_joint, add_sensor]
+
+
+def _ground_with_a_box() -> tumble.World:
+    world = tumble.World()
+    world.add_static(tumble.Plane())
+    world.add_body(tumble.Box((0.4, 0.3, 0.2)), mass=1.0, position=(0.0, 0.0, 0.3), angular_velocity=(0.3, 0.2, 1.0))
+    return world
+
+
+def _run_contacts(make, dt: float, full_path: bool, changes) -> list:
+    world = make()
+    seen = []
+    for change in [None, *changes]:
+        if change is not None:
+            change(world)
+        for _ in range(max(5, round(1.0 / (12.0 * dt)))):
+            if full_path:
+                world._scratch.ready = None
+            world.step(dt)
+            seen.append(world.state.digest())
+    return seen + [world.state.contact_count, world._scratch.steps_found_again]
+
+
+@pytest.mark.parametrize("hertz", [60, 240, 1000])
+def test_the_prepared_soft_step_steps_as_the_full_path_through_every_change(hertz):
+    prepared = _run_contacts(_ground_with_a_box, 1.0 / hertz, False, _contact_changes())
+    assert prepared[-2] > 0 and prepared == _run_contacts(_ground_with_a_box, 1.0 / hertz, True, _contact_changes())
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+@pytest.mark.parametrize("hertz", [60, 240])
+def test_a_pile_steps_the_same_prepared_whatever_its_seed(seed, hertz):
+    """A falling pile grows its contact buffers while it lands (the full path takes those steps): over seeds."""
+
+    def pile():
+        return scenes.box_pile(8, seed=seed)
+
+    prepared = _run_contacts(pile, 1.0 / hertz, False, [])
+    assert prepared[-2] > 0 and prepared == _run_contacts(pile, 1.0 / hertz, True, [])
+
+
+def test_a_resting_box_keeps_its_prepared_soft_step():
+    world = _ground_with_a_box()
+    for _ in range(30):
+        world.step(1 / 60)
+    ready = world._scratch.ready
+    assert type(ready).__name__ == "_ReadyContactStep"
+    for _ in range(30):
+        world.step(1 / 60)
+    assert world._scratch.ready is ready and world.state.contact_count == 1
+
+
+def test_a_prepared_soft_step_refuses_too_many_substeps_and_moves_nothing():
+    world = _ground_with_a_box()
+    world.step(1 / 60)
+    world.step(1 / 60)
+    before = world.state.digest()
+    with pytest.raises(ValueError, match="substeps"):
+        world.step(1e3)
+    assert world.state.digest() == before
+    world.step(1 / 60)
+    assert world.step_count == 3
