@@ -82,7 +82,7 @@ def simulate_steps(
     else:
         method = int(params.resolve_integrator(False))
         world = compiled_world(model, state, inputs, params, scratch, acts, recording).record
-        steps = _free_body_steps(world, state, acts, scratch, h, n_steps, method, record_every, stage, clock)
+        steps = _free_body_steps(world, state, inputs, acts, scratch, h, n_steps, method, record_every, stage, clock)
         advance_clock(state, h, steps.done)
     # The applied loads act in the first step; one that failed drops them too (the world keeps its state from
     # before it), or a load that makes every step overflow (RK4 sums four stages of it) would leave it stuck.
@@ -105,35 +105,28 @@ def _free_steps(stage, world, h, n_steps, chunk, method, record_every, first, la
     counted start time; the rows are backed up, advanced (``advance_rows``), and on a non-finite value restored and
     replayed to the last step all completed; the motors of these bodies advance by the chunk; the driven bodies are
     woken first. Returns ``(steps_done, failing_body, failing_controller)``, -1 for none. The applied loads
-    (``world.loads``) act in step 0. Releases the GIL (``nogil``).
+    (``world.loads``) act in step 0, and are zeroed when it returns. Releases the GIL (``nogil``).
 
-    The replay goes through the same call of ``advance_rows`` as the chunk: it is compiled into this loop, and a
-    second call would compile the integrators twice (5 s more of a cold start)."""
-    bodies, gravity, backup, rec, failed_step = (
-        world.model_rows[0],
-        world.gravity,
-        world.free_backup,
-        world.rec,
-        world.failed_step,
-    )
-    force, torque, acts = world.loads
+    The replay goes through the same call of ``advance_rows`` as the chunk. It takes the record and the few arrays
+    this loop writes itself: every array a compiled function holds costs two atomic reference counts per call."""
+    gravity, backup, failed_step = world.gravity, world.free_backup, world.failed_step
+    driven, rotors = world.loads[2].driven, world.loads[2].first  # the actuators' arrays taken where used
     pos, quat, linvel, angmom, sleep_time, sleeping = world.body_state[:6]
     for i in range(first, last):  # thrust that holds a body still must not let it sleep
-        if acts.driven[i]:
+        if driven[i]:
             sleep_time[i], sleeping[i] = 0.0, False
     done = 0
     while done < n_steps:
         end = min(done + chunk, n_steps)
         t = origin_time + (origin_count + done) * h
-        failing_controller = command_stage(stage, gravity, acts, pos, quat, linvel, angmom, t, h)  # noqa: F821
+        failing_controller = command_stage(stage, gravity, world.loads[2], pos, quat, linvel, angmom, t, h)  # noqa: F821
         if failing_controller >= 0:
-            return done, -1, failing_controller
+            return _loads_dropped(world, first, last, done, -1, failing_controller)
         for i in range(first, last):
             _save_row(i, pos, quat, linvel, angmom, backup)
         failing_body = -1
         while True:  # the chunk; after a failure, once more from the backup up to the failing step
-            advance_rows(first, last, bodies, gravity, force, torque, acts, pos, quat, linvel, angmom, rec,
-                         failed_step, h, done, end, method, record_every)  # fmt: skip
+            advance_rows(first, last, world, h, done, end, method, record_every)
             failing_step, body = _first_failure(failed_step, first, last, end)
             if body < 0:
                 break
@@ -141,12 +134,25 @@ def _free_steps(stage, world, h, n_steps, chunk, method, record_every, first, la
             for i in range(first, last):
                 _restore_row(i, pos, quat, linvel, angmom, backup)
             if end == done:
-                return done, failing_body, -1
-        advance_motors(acts, first, last, (end - done) * h)
+                return _loads_dropped(world, first, last, done, failing_body, -1)
+        if rotors[last] > rotors[first]:  # a call costs its arrays' reference counts: only for rotors
+            advance_motors(world.loads[2], first, last, (end - done) * h)
         done = end
         if failing_body >= 0:
-            return done, failing_body, -1
-    return n_steps, -1, -1
+            return _loads_dropped(world, first, last, done, failing_body, -1)
+    return _loads_dropped(world, first, last, n_steps, -1, -1)
+
+
+@inline
+def _loads_dropped(world, first, last, done, failing_body, failing_controller):
+    """``(done, failing_body, failing_controller)``, the applied loads of bodies ``first..last-1`` zeroed: they act
+    in a call's first step only, and a call that failed drops them too (``simulate_steps``)."""
+    force, torque = world.loads[0], world.loads[1]
+    for i in range(first, last):
+        for k in range(3):
+            force[i, k] = 0.0
+            torque[i, k] = 0.0
+    return done, failing_body, failing_controller
 
 
 @inline
@@ -193,7 +199,7 @@ def _staged_steps(command):
     return kernel_for(_free_steps, f"free_steps_{name}", command_stage=command)
 
 
-def _free_body_steps(world, state, acts, scratch, h, n_steps, method, record_every, stage, clock):
+def _free_body_steps(world, state, inputs, acts, scratch, h, n_steps, method, record_every, stage, clock):
     """The free bodies' loop over the ``world`` record: without a stage one chunk of all the steps, split over the
     threads when the work is large (rows are independent: any split gives the same bits); with one, a chunk a step
     on this thread."""
@@ -205,7 +211,7 @@ def _free_body_steps(world, state, acts, scratch, h, n_steps, method, record_eve
                                                              int(origin_count)))  # fmt: skip
     if n < 2 or n * n_steps < integrate.PARALLEL_MIN_WORK or integrate.threads() < 2:
         return Steps(*_plain_steps(0, world, h, n_steps, n_steps, method, record_every, 0, n, 0.0, 0))
-    speeds = acts.speed.copy()
+    speeds, loads = acts.speed.copy(), (inputs.body_force.copy(), inputs.body_torque.copy())
     bounds = np.linspace(0, n, min(integrate.threads(), n) + 1).astype(np.int64)
     futures = [
         integrate.thread_pool().submit(
@@ -222,6 +228,8 @@ def _free_body_steps(world, state, acts, scratch, h, n_steps, method, record_eve
     for array, saved in zip(arrays, scratch.backup, strict=True):
         np.copyto(array, saved)
     np.copyto(acts.speed, speeds)
+    np.copyto(inputs.body_force, loads[0])  # each block dropped its rows' loads: the replay's first step has them
+    np.copyto(inputs.body_torque, loads[1])
     if first_failure.done > 0:
         _plain_steps(0, world, h, first_failure.done, first_failure.done, method, record_every, 0, n, 0.0, 0)
     return first_failure
@@ -263,9 +271,11 @@ class ReadyStep:
     def __call__(self, h: float) -> int:
         """One step of ``h``: the row of the body that became non-finite (the arrays as they were), or -1."""
         done, failing, _ = _plain_steps(0, self._record, h, 1, 1, self._method, 0, 0, self._bodies, 0.0, 0)
-        advance_clock(self._state, h, done)
-        self._inputs.clear()  # as simulate_steps: the loads act in this step, or are dropped with it
-        return failing
+        if done:  # advance_clock's sum for one step
+            state = self._state
+            state.time += h
+            state.step_count += 1
+        return failing  # the loop dropped the loads (they act in this step, or are dropped with it)
 
 
 class _ReadyContactStep(ReadyStep):

@@ -48,11 +48,16 @@ def test_a_failure_in_one_block_of_threads_leaves_what_one_thread_leaves(monkeyp
     back, motors included, and replays the steps that all the bodies completed."""
     monkeypatch.setattr(integrate, "PARALLEL_MIN_WORK", 1)
     results = {}
-    for count in (1, 2):
+    for count, push in ((1, True), (2, True), (1, False)):
         with integrate.using_threads(count):
-            results[count] = _run_until_failure(*_rotors_and_a_runaway())
-    assert results[1] == results[2]
-    step, *_ = results[1]
+            world, rotors = _rotors_and_a_runaway()
+            if push:  # applied loads act in the first step: in the replay's too, though each block dropped its own
+                world.bodies[0].apply_force((0.0, 0.3, 0.0))
+                world.bodies[1].apply_torque((0.0, 0.0, 0.01))
+            results[count, push] = _run_until_failure(world, rotors)
+    assert results[1, True] == results[2, True]
+    assert results[1, True][1] != results[1, False][1]  # the loads count
+    step, *_ = results[1, True]
     assert 10 < step < 30
 
 
