@@ -1,6 +1,8 @@
 """Where a ``world.step()`` call's time goes (issue 46): the call, the same step inside ``simulate``, and the entry into
 the runner's compiled loop (a call of it for no step at all, with the arguments the runner passes); the Python of the
-call is the rest. Internals are called by name: this is a measurement of them, not an API.
+call is the rest. Beside them, the arrays compiled code allocates (and frees) in a step, counted by Numba's runtime:
+each costs a ``malloc``, a ``free`` and atomic reference counts. Internals are called by name: this is a measurement
+of them, not an API.
 
 Run from the repository root:
 
@@ -10,6 +12,8 @@ Run from the repository root:
 from __future__ import annotations
 
 import time
+
+from numba.core.runtime import _nrt_python
 
 from tumble import runner
 
@@ -36,8 +40,20 @@ def _entry_call(world):
     return lambda: runner._plain_steps(0, record, DT, 0, 0, 0, 0, 0, bodies, 0.0, 0)
 
 
+def _allocations_per_step(world, steps: int = 100) -> float:
+    """The arrays compiled code allocates in one ``world.step`` (Numba's runtime counts them while asked to)."""
+    _nrt_python.memsys_enable_stats()
+    try:
+        before = _nrt_python.memsys_get_stats_alloc()
+        for _ in range(steps):
+            world.step(DT)
+        return (_nrt_python.memsys_get_stats_alloc() - before) / steps
+    finally:
+        _nrt_python.memsys_disable_stats()
+
+
 def breakdown() -> list[dict]:
-    """One row per scene: ``step_us``, ``simulate_us``, ``entry_us``, ``python_us``."""
+    """One row per scene: ``step_us``, ``simulate_us``, ``entry_us``, ``python_us``, ``allocations``."""
     rows = []
     for scene, make in (("one free body", one_free_body), ("box on a plane", box_on_a_plane)):
         world = make()
@@ -50,7 +66,7 @@ def breakdown() -> list[dict]:
         inside = 1e6 * (time.perf_counter() - start) / 3000
         entry = _microseconds(_entry_call(world), 20000)
         rows.append({"scene": scene, "step_us": step, "simulate_us": inside, "entry_us": entry,
-                     "python_us": step - inside - entry})  # fmt: skip
+                     "python_us": step - inside - entry, "allocations": _allocations_per_step(world)})  # fmt: skip
     return rows
 
 

@@ -176,6 +176,8 @@ def test_the_step_breakdown_splits_each_call_into_its_parts():
         # No timing compared: under a loaded test run the step and the same step inside simulate can swap.
         assert row["step_us"] > 0 and row["simulate_us"] > 0 and row["entry_us"] > 0
         assert row["python_us"] == pytest.approx(row["step_us"] - row["simulate_us"] - row["entry_us"])
+    free, box = rows
+    assert free["allocations"] == 0 and box["allocations"] > 0  # counted: the free loop allocates nothing
 
 
 def test_contact_rows_for_the_peers():

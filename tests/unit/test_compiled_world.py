@@ -11,6 +11,7 @@ import pytest
 
 import tumble
 from compiled import compiled_only
+from stepping import steps_through
 from tumble import scenes
 from tumble.actuators import Thruster
 
@@ -60,20 +61,14 @@ def _changes():
 
 
 def _run(make, dt: float, fresh_each_step: bool) -> tuple[list[str], int]:
-    """The digests after each change and the steps that follow it (a twelfth of a second, at least 5 steps), and the
-    contacts at the end; with ``fresh_each_step`` the kept record is dropped before every step, so that each step
-    builds its own."""
+    """The digests after every step through every change, and the contacts at the end; with ``fresh_each_step`` the
+    kept record is dropped before every step, so that each step builds its own."""
+
+    def fresh(world):
+        world._scratch.compiled = None
+
     world = make()
-    digests = []
-    for change in [None, *_changes()]:
-        if change is not None:
-            change(world)
-        for _ in range(max(5, round(1.0 / (12.0 * dt)))):
-            if fresh_each_step:
-                world._scratch.compiled = None
-            world.step(dt)
-        digests.append(world.state.digest())
-    return digests, world.state.contact_count
+    return steps_through(world, dt, _changes(), fresh if fresh_each_step else None), world.state.contact_count
 
 
 HERTZ = [60, 240, 1000]

@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 import tumble
+from stepping import steps_through
 from tumble import scenes
 from tumble.actuators import Thruster
 from tumble.errors import SimulationError
@@ -84,22 +85,16 @@ def _changes():
             add_drag_and_wind, calm_the_wind, add_sensor], parts  # fmt: skip
 
 
+def _forget(world: tumble.World) -> None:
+    world._scratch.ready = None
+
+
 def _run(dt: float, full_path: bool) -> list:
-    """The digests after each change and the steps that follow it, and the IMU's last reading; with ``full_path`` the
-    prepared step is dropped before every step."""
+    """The free bodies' digests through every change, and the IMU's last reading."""
     world = _spinning_bodies()
     changes, parts = _changes()
-    seen = []
-    for change in [None, *changes]:
-        if change is not None:
-            change(world)
-        for _ in range(max(5, round(1.0 / (12.0 * dt)))):
-            if full_path:
-                world._scratch.ready = None
-            world.step(dt)
-        seen.append(world.state.digest())
-    seen.append(np.concatenate(parts["imu"].read()).tobytes())
-    return seen
+    seen = steps_through(world, dt, changes, _forget if full_path else None)
+    return seen + [np.concatenate(parts["imu"].read()).tobytes()]
 
 
 @pytest.mark.parametrize("hertz", [60, 240, 1000])
@@ -239,15 +234,7 @@ def _ground_with_a_box() -> tumble.World:
 
 def _run_contacts(make, dt: float, full_path: bool, changes) -> list:
     world = make()
-    seen = []
-    for change in [None, *changes]:
-        if change is not None:
-            change(world)
-        for _ in range(max(5, round(1.0 / (12.0 * dt)))):
-            if full_path:
-                world._scratch.ready = None
-            world.step(dt)
-            seen.append(world.state.digest())
+    seen = steps_through(world, dt, changes, _forget if full_path else None)
     return seen + [world.state.contact_count, world._scratch.steps_found_again]
 
 
