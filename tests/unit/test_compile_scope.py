@@ -18,10 +18,11 @@ import subprocess
 import sys
 
 import numpy as np
+import pytest
 
 from compiled import compiled_only
 from tumble import math3d, scenes
-from tumble._jit import kernel
+from tumble._jit import inline, kernel
 from tumble.geometry import narrow_phase
 from tumble.shapes import ShapeType
 
@@ -154,3 +155,75 @@ def test_the_free_body_integrator_compiles_its_per_body_calls_into_the_row_loop(
     # Once per call, not per body: it takes the record and holds its arrays itself (its docstring says why).
     assert "inline" not in integrate.advance_rows.targetoptions
     assert "inline" not in math3d.dot.targetoptions  # the other helpers are left to LLVM
+
+
+@inline(counted=False)
+def _a_view_of(a):
+    return a[1:]
+
+
+@kernel
+def _sum_of_a_view(a):
+    return _a_view_of(a).sum()
+
+
+@inline(counted=False)
+def _the_same(a):
+    return a, 1.0
+
+
+@kernel
+def _sum_of_the_same(a):
+    return _the_same(a)[0].sum()
+
+
+@inline(counted=False)
+def _a_sum_of_zeros(n):
+    return np.zeros(n).sum()
+
+
+@kernel
+def _sum_of_zeros(n):
+    return _a_sum_of_zeros(n)
+
+
+@inline(counted=False)
+def _doubled_in_place(a):
+    for i in range(a.shape[0]):
+        a[i] *= 2.0
+
+
+@kernel
+def _doubled(a):
+    _doubled_in_place(a[1:])
+    return a
+
+
+@needs_jit
+def test_a_helper_without_reference_counts_may_not_return_an_array_nor_allocate_one():
+    """Its caller would release a reference it never got (a view's memory freed under it): refused at compile time,
+    as an allocation is (there would be nothing to free it)."""
+    with pytest.raises(Exception, match="may not return arrays"):  # refused by _jit
+        _sum_of_the_same(np.ones(3))
+    with pytest.raises(Exception, match="returning of array passed"):  # refused by Numba
+        _sum_of_a_view(np.ones(3))
+    with pytest.raises(Exception, match="returning of array passed|NRT required"):
+        _sum_of_zeros(3)
+    a = np.ones(4)
+    assert _doubled(a) is a and a.tolist() == [1.0, 2.0, 2.0, 2.0]  # what it may do: write the arrays it is given
+
+
+def test_the_contact_substeps_run_without_reference_counts():
+    """The functions a soft step calls per substep, and once per step over many arrays, count no references: each
+    array a counted function holds costs two atomic operations a call (three quarters of a box's step on a plane)."""
+    from tumble.dynamics import contact_solver, islands, joint_solver, substep
+    from tumble.geometry import narrow_phase as narrow
+
+    uncounted = (substep.integrate_velocities, substep.integrate_positions, substep.to_angular_momentum,
+                 contact_solver.warm_start_contacts, contact_solver.solve_contacts, contact_solver.accumulate_impulses,
+                 contact_solver.resolve_impacts, contact_solver.prepare_contacts, contact_solver.store_impulses,
+                 contact_solver.apply_restitution, joint_solver.warm_start_joints, narrow.match_warm_start,
+                 narrow.passes_due, islands.update_sleep, islands.wake_touched)  # fmt: skip
+    for helper in uncounted:
+        options = getattr(helper, "targetoptions", {"_nrt": False})  # plain Python without Numba
+        assert options.get("_nrt") is False, helper.__name__

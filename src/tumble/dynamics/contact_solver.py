@@ -211,7 +211,7 @@ def _write_rolling_masses(rows, m, ia, ib, t1, t2):
         rows.rolling_mass[m, 1] = _inverse_angular_mass(ia, ib, t2)
 
 
-@inline
+@inline(counted=False)
 def prepare_contacts(
     manifolds, count, shape_body, shape_friction, shape_restitution, shape_rolling, shape_core_radius, inv_mass,
     inv_inertia_world, pos, linvel,
@@ -420,7 +420,7 @@ def _store_pair(linvel, angvel, a, b, va, wa, vb, wb):
     store3(angvel, b, wb)
 
 
-@inline
+@inline(counted=False)
 def warm_start_contacts(rows, count, inv_mass, inv_inertia_world, pos, quat, pos0, quat0, linvel, angvel):
     """Re-apply the accumulated impulses of every point (normal and friction).
 
@@ -446,7 +446,7 @@ def warm_start_contacts(rows, count, inv_mass, inv_inertia_world, pos, quat, pos
         _store_pair(linvel, angvel, a, b, va, wa, vb, wb)
 
 
-@inline
+@inline(counted=False)
 def solve_contacts(
     rows, count, inv_mass, inv_inertia_world, pos, quat, pos0, quat0, linvel, angvel, inv_h, push_max, use_bias,
     threshold,
@@ -560,8 +560,17 @@ def _move_back(i, dv, dw, tau, inv_mass, pos, quat):
 
 
 @inline
+def impact_work():
+    """The work arrays of :func:`resolve_impacts`, one row per point of a manifold: each point's approach speed at
+    its touch (-1: it does not bounce now), when it touches within the substep [s], the normal velocity its bounce
+    leaves it with, its impulse, and its arms at the time of touch (a and b)."""
+    return (np.zeros(MAX_POINTS), np.zeros(MAX_POINTS), np.zeros(MAX_POINTS), np.zeros(MAX_POINTS),
+            np.zeros((MAX_POINTS, 3)), np.zeros((MAX_POINTS, 3)))  # fmt: skip
+
+
+@inline(counted=False)
 def resolve_impacts(rows, count, inv_mass, inv_inertia_world, pos, quat, pos0, quat0, linvel, angvel, h, threshold,
-                    gravity, force, constant_force):  # fmt: skip
+                    gravity, force, constant_force, work):  # fmt: skip
     """Bounce impacts as they happen, at the time of touch within the substep, one after the other, so momentum
     passes along a row.
 
@@ -578,13 +587,10 @@ def resolve_impacts(rows, count, inv_mass, inv_inertia_world, pos, quat, pos0, q
     ball then strikes the next (Newton's cradle), and a corner that touches later in the substep bounces then.
     Resolving the impacts inside the substeps' inelastic solve instead would merge a touching row into one body.
     Writes: linvel, angvel, pos, quat, and ``rows.relative_velocity`` (0: bounced, so that
-    :func:`apply_restitution` leaves the point alone).
+    :func:`apply_restitution` leaves the point alone). ``work``: :func:`impact_work`'s arrays (compiled without
+    reference counts, this function may not allocate them).
     """
-    u_surface = np.zeros(MAX_POINTS)  # each point's approach speed at its touch (-1: it does not bounce now)
-    touch = np.zeros(MAX_POINTS)  # when it touches within the substep [s]
-    target = np.zeros(MAX_POINTS)  # the normal velocity its bounce leaves it with
-    impulse = np.zeros(MAX_POINTS)
-    arm_a, arm_b = np.zeros((MAX_POINTS, 3)), np.zeros((MAX_POINTS, 3))  # the arms at the time of touch
+    u_surface, touch, target, impulse, arm_a, arm_b = work  # impact_work(): written before they are read
     for _ in range(count + 1):
         bounced = False
         for m in range(count):
@@ -654,7 +660,7 @@ def resolve_impacts(rows, count, inv_mass, inv_inertia_world, pos, quat, pos0, q
             break
 
 
-@inline
+@inline(counted=False)
 def apply_restitution(rows, count, inv_mass, inv_inertia_world, pos, quat, pos0, quat0, linvel, angvel, threshold):
     """Bounce: drive the normal velocity to ``−e`` times its approach velocity, where there was an impact that
     :func:`resolve_impacts` did not bounce (one that sped up past ``threshold`` only in the substep it touched).
@@ -683,7 +689,7 @@ def apply_restitution(rows, count, inv_mass, inv_inertia_world, pos, quat, pos0,
         _store_pair(linvel, angvel, a, b, va, wa, vb, wb)
 
 
-@inline
+@inline(counted=False)
 def accumulate_impulses(rows, count):
     """Add the impulses each point applied during a substep to the step's totals (for ``World.contacts``)."""
     for m in range(count):
@@ -693,7 +699,7 @@ def accumulate_impulses(rows, count):
             rows.total_tangent_impulse[m, j, 1] += rows.tangent_impulse[m, j, 1]
 
 
-@inline
+@inline(counted=False)
 def store_impulses(manifolds, rows, count, shape_a, shape_b, point_count, feature, normal_impulse, tangent_impulse):
     """Keep this step's impulses, keyed by shape pair and feature, to warm-start the next step: the first ``count``
     rows of the contact state's arrays (``State.contact_*``), friction as world vectors. Slots past each manifold's

@@ -59,7 +59,7 @@ def _islands(is_dynamic, shape_body, manifold_a, manifold_b, point_count, separa
         parent[i] = _find(parent, i)
 
 
-@inline
+@inline(counted=False)
 def update_sleep(
     is_dynamic, shape_body, manifolds, count, joint_a, joint_b, linvel, angvel, dt, sleep_linear, sleep_angular,
     time_to_sleep, sleep_time, sleeping, island, parent, island_min_time,
@@ -107,7 +107,7 @@ def _wake_island(sleeping, sleep_time, island, root):
     return woken
 
 
-@inline
+@inline(counted=False)
 def wake_touched(is_dynamic, shape_body, manifolds, count, joint_a, joint_b, sleep_time, sleeping, island):
     """Wake every sleeping island that an awake dynamic body touches (or nearly touches) or is jointed to.
 

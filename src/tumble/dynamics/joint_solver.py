@@ -405,7 +405,7 @@ def _swing(fa, fb):
     return elementary.atan2(sine, dot(na, nb)), axis
 
 
-@inline
+@inline(counted=False)
 def warm_start_joints(joints, impulses, inv_mass, inv_inertia_world, pos, quat, linvel, angvel, force_total,
                       moment_total):  # fmt: skip
     """Re-apply every joint's accumulated impulses at the current poses. Writes: velocities, the totals."""

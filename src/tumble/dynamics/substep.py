@@ -24,7 +24,7 @@ from ..math3d import (
     world_inertia_apply,
 )
 from .actuation import actuator_wrench
-from .contact_solver import accumulate_impulses, resolve_impacts, solve_contacts, warm_start_contacts
+from .contact_solver import accumulate_impulses, impact_work, resolve_impacts, solve_contacts, warm_start_contacts
 from .free_motion import implicit_spin
 from .joint_solver import solve_joints, warm_start_joints
 
@@ -49,7 +49,7 @@ def to_angular_velocity(bodies, quat, angmom, angvel, inv_inertia_world):
             inv_inertia_world[i, 2, c] = column[2]
 
 
-@inline
+@inline(counted=False)
 def to_angular_momentum(bodies, quat, angvel, angmom):
     """``L = R I Rᵀ ω`` of every dynamic body. Writes: angmom."""
     for i in range(quat.shape[0]):
@@ -57,7 +57,7 @@ def to_angular_momentum(bodies, quat, angvel, angmom):
             store3(angmom, i, world_inertia_apply(load4(quat, i), load33(bodies.inertia_local, i), load3(angvel, i)))
 
 
-@inline
+@inline(counted=False)
 def integrate_velocities(bodies, moving, gravity, force, torque, acts, tau, quat, linvel, angvel, h):
     """``v += h (g + F/m)`` (``gravity``: (bodies, 3), each body's ``g``), implicit gyroscopic spin update, implicit
     damping; moving (awake dynamic) bodies. The actuators' and drag's loads are those of the substep's start state,
@@ -80,7 +80,7 @@ def integrate_velocities(bodies, moving, gravity, force, torque, acts, tau, quat
         store3(angvel, i, quat_rotate(q, w_body))
 
 
-@inline
+@inline(counted=False)
 def integrate_positions(moving, linvel, angvel, pos, quat, h):
     """``x += h v``, ``q ← q + h ½ (0, ω) ⊗ q`` renormalised; moving (awake dynamic) bodies."""
     for i in range(pos.shape[0]):
@@ -103,10 +103,11 @@ def run_substeps(
     solver then treats as fixed."""
     inv_h = 1.0 / h
     jointed = joints.kind.shape[0] > 0  # without joints, not even the joint solver's work arrays
+    impacts = impact_work()
     for k in range(first, last):
         integrate_velocities(bodies, moving, gravity, force, torque, acts, k * h, quat, linvel, angvel, h)
         resolve_impacts(rows, count, inv_mass, inv_inertia_world, pos, quat, pos0, quat0, linvel, angvel, h, threshold,
-                        gravity, force, bodies.constant_force)  # fmt: skip
+                        gravity, force, bodies.constant_force, impacts)  # fmt: skip
         if jointed:
             warm_start_joints(joints, joint_impulses, inv_mass, inv_inertia_world, pos, quat, linvel, angvel,
                               joint_force_total, joint_moment_total)  # fmt: skip

@@ -251,7 +251,7 @@ compiled_collide_each = kernel_for(
 )
 
 
-@inline
+@inline(counted=False)
 def passes_due(passes, count, k, substeps, listed):
     """The manifolds whose contacts are found again before substep ``k``, into ``listed``; returns how many:
     ``passes[m]`` equal runs of the substeps for manifold ``m`` (as equal as whole substeps allow)."""
@@ -302,7 +302,7 @@ def contact_passes(shape_body, aabb_center_local, aabb_half_local, moving, shape
     return most
 
 
-@inline
+@inline(counted=False)
 def match_warm_start(
     manifolds, count, prev_a, prev_b, prev_point_count, prev_feature, prev_normal, prev_tangent, warm_normal,
     warm_tangent,
