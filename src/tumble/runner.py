@@ -241,13 +241,14 @@ class ReadyStep:
     else. ``World.step`` takes it while it :meth:`fits`; anything else the step reads (controllers, sensors, the
     wind) is the caller's to check. This class steps free bodies; :class:`_ReadyContactStep` contacts and joints."""
 
-    __slots__ = ("_objects", "_integrator", "_record", "_method", "_bodies", "_state", "_inputs")
+    __slots__ = ("_objects", "_integrator", "_compiled", "_record", "_method", "_bodies", "_state", "_inputs")
 
     def __init__(self, model: Model, state: State, inputs: Inputs, params: Params, scratch: Scratch,
                  acts: ActuatorArrays):  # fmt: skip
         self._objects = held(model, state, inputs, params, acts)
         self._integrator = params.integrator
-        self._record = compiled_world(model, state, inputs, params, scratch, acts).record
+        self._compiled = compiled_world(model, state, inputs, params, scratch, acts)
+        self._record = self._compiled.record
         self._method = int(params.resolve_integrator(False))
         self._bodies = state.body_count
         self._state, self._inputs = state, inputs
@@ -283,14 +284,12 @@ class _ReadyContactStep(ReadyStep):
     rows stay where the last step left them, while the state holds their views (:meth:`fits`). A step that must grow
     the contact buffers takes the full path."""
 
-    __slots__ = ("_parts", "_scratch", "_progress", "_backup", "_h", "_substeps")
+    __slots__ = ("_model", "_params", "_acts", "_scratch", "_h", "_substeps")
 
     def __init__(self, model: Model, state: State, inputs: Inputs, params: Params, scratch: Scratch,
                  acts: ActuatorArrays):  # fmt: skip
         super().__init__(model, state, inputs, params, scratch, acts)
-        compiled = scratch.compiled[1]
-        self._parts = model, params, acts
-        self._scratch, self._progress, self._backup = scratch, compiled.progress, compiled.backup
+        self._model, self._params, self._acts, self._scratch = model, params, acts, scratch
         self._h, self._substeps = math.nan, 0
 
     def fits(self, model: Model, state: State, inputs: Inputs, params: Params, acts: ActuatorArrays) -> bool:
@@ -298,21 +297,22 @@ class _ReadyContactStep(ReadyStep):
 
     def __call__(self, h: float) -> int:
         if h != self._h:  # a ValueError before anything moved, as the full path's
-            self._substeps, self._h = self._parts[1].solver.substeps_for(h), h
+            self._substeps, self._h = self._params.solver.substeps_for(h), h
         scratch, state = self._scratch, self._state
         count = scratch.contact_count
         try:
             done, failing, _, count, needed = _plain_contact_loop(0, self._record, count, 0, h, self._substeps, 0, 1,
                                                                   0.0, 0)  # fmt: skip
         except (ZeroDivisionError, FloatingPointError):  # a kernel divided by an overflowed value
-            done, count, failing = _restored(self._progress, self._backup, state, scratch, self._parts[0])
+            done, count, failing = _restored(self._compiled.progress, self._compiled.backup, state, scratch,
+                                             self._model)  # fmt: skip
         else:
             if needed > 0:  # nothing of the step ran: the full path grows the buffers and takes it
-                model, params, acts = self._parts
-                return simulate_steps(model, state, self._inputs, params, scratch, h, acts=acts).failing_body
+                return simulate_steps(self._model, state, self._inputs, self._params, scratch, h,
+                                      acts=self._acts).failing_body  # fmt: skip
         if done > 0:
             scratch.joint_step = h
-        _leave_contacts(state, scratch, count, self._progress, True)
+        _leave_contacts(state, scratch, count, self._compiled.progress, True)
         advance_clock(state, h, done)
         self._inputs.clear()
         return failing

@@ -247,13 +247,44 @@ def test_the_prepared_soft_step_steps_as_the_full_path_through_every_change(hert
 @pytest.mark.parametrize("seed", [0, 1, 2])
 @pytest.mark.parametrize("hertz", [60, 240])
 def test_a_pile_steps_the_same_prepared_whatever_its_seed(seed, hertz):
-    """A falling pile grows its contact buffers while it lands (the full path takes those steps): over seeds."""
+    """A pile falls for 0.75 s and lands: its contacts outgrow the buffers while it has a prepared step (which then
+    hands the step to the full path, which grows them): the same bits as the full path at every step, over seeds."""
+    dt = 1.0 / hertz
+    prepared, full = scenes.box_pile(8, seed=seed), scenes.box_pile(8, seed=seed)
+    grew_while_prepared = 0
+    for _ in range(round(0.75 / dt)):
+        ready, capacity = prepared._scratch.ready, prepared._scratch.manifolds.shape_a.shape[0]
+        prepared.step(dt)
+        grew_while_prepared += ready is not None and prepared._scratch.manifolds.shape_a.shape[0] > capacity
+        full._scratch.ready = None
+        full.step(dt)
+        assert prepared.state.digest() == full.state.digest()
+    assert prepared.state.contact_count >= 8, grew_while_prepared
+    assert grew_while_prepared > 0
 
-    def pile():
-        return scenes.box_pile(8, seed=seed)
 
-    prepared = _run_contacts(pile, 1.0 / hertz, False, [])
-    assert prepared[-2] > 0 and prepared == _run_contacts(pile, 1.0 / hertz, True, [])
+def test_many_free_bodies_prepare_a_step_until_one_step_is_split_over_threads(monkeypatch):
+    """Up to ``PARALLEL_MIN_WORK`` bodies a step is one call on this thread, prepared; past it the full path splits
+    the bodies over the threads (the same bits either way: rows are independent)."""
+    from tumble.dynamics import integrate
+
+    def spinning(count):
+        world = tumble.World()
+        for k in range(count):
+            world.add_body(tumble.Box((0.3, 0.2, 0.1)), mass=1.0, position=(k, 0.0, 0.0), collision_mask=0,
+                           angular_velocity=(1.0, 2.0 + k % 7, 3.0))  # fmt: skip
+        return world
+
+    digests = []
+    for limit in (10_000, 200):  # 1000 bodies: prepared; then split (threads permitting)
+        monkeypatch.setattr(integrate, "PARALLEL_MIN_WORK", limit)
+        world = spinning(1000)
+        world.bodies[3].apply_force((0.0, 5.0, 0.0))
+        for _ in range(20):
+            world.step(1 / 240)
+        assert (world._scratch.ready is not None) == (limit > 1000)
+        digests.append(world.state.digest())
+    assert digests[0] == digests[1]
 
 
 def test_a_resting_box_keeps_its_prepared_soft_step():
