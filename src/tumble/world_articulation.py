@@ -33,8 +33,14 @@ def _check(art) -> None:
             f"the articulation has {len(art.actuators)} actuators: world joints have none; step the "
             "articulation on its own, or apply their forces (WorldArticulation.apply_joint_forces)"
         )
+    if art.tendons:
+        raise ValueError(f"the articulation has {len(art.tendons)} tendons: world joints have none; step the "
+                         "articulation on its own")  # fmt: skip
     for link in art.links:
         label = link.name or link.index
+        if link.limits is not None or link.frictionloss != 0.0:
+            raise ValueError(f"link {label!r} has joint limits or frictionloss: an articulation's limits do not carry "
+                             "over to world joints (yet); step the articulation on its own")  # fmt: skip
         if link.mass_properties is None or not link.mass_properties.mass > 0.0:
             raise ValueError(f"link {label!r} has no mass: every link of an articulation in a world becomes a body")
         for name in ("armature", "stiffness"):

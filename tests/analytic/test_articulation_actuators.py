@@ -122,3 +122,55 @@ def test_bad_actuators_and_controls_are_refused_and_change_nothing():
     with pytest.raises(ValueError, match=r"ctrl"):
         art.ctrl = [float("inf")]
     assert art.ctrl.tolist() == [0.0]
+
+
+@pytest.mark.parametrize("dt", [1 / 60, 1 / 240, 1e-3])
+def test_force_range_clips_a_servo_so_the_wheel_spins_up_at_the_clipped_torque(dt):
+    """A position servo far from its target pulls with ``kp · error``, clipped to ``force_range``: the wheel spins up
+    at ``gear · f_max / I`` until it comes near."""
+    art = wheel(gear=2.0, gain=100.0, bias=(0.0, -100.0, 0.0), force_range=(-0.5, 0.25))
+    art.ctrl = [40.0]  # a target 20 rad away
+    assert art.forward_dynamics()[0] == pytest.approx(2.0 * 0.25 / INERTIA, rel=1e-15)
+    np.testing.assert_allclose(art.actuator_forces(), [0.25])
+    art.simulate(1.0, dt, integrator="rk4")
+    assert art.qd[0] == pytest.approx(2.0 * 0.25 / INERTIA, rel=1e-12)
+
+
+def _two_wheels(**tendon):
+    art = Articulation(gravity=(0.0, 0.0, 0.0))
+    first = art.add_link(Revolute((0, 0, 1)), mass=2.0, shape_position=(0.5, 0.0, 0.0))  # I = 0.5
+    second = art.add_link(Revolute((0, 0, 1)), position=(3.0, 0, 0), mass=1.0, shape_position=(1.0, 0.0, 0.0))  # 1
+    return art, art.add_tendon([first, second], [1.0, -2.0], **tendon)
+
+
+@pytest.mark.parametrize("dt", [1 / 60, 1 / 240, 1e-3])
+def test_a_tendon_spring_couples_two_wheels_at_its_normal_frequency(dt):
+    """A fixed tendon ``L = q₀ - 2 q₁`` with stiffness ``k`` on two free wheels (inertias I₀, I₁): ``L`` oscillates
+    about its spring length at ``ω² = k (1/I₀ + 4/I₁)``, and ``I₀ q̇₀ + I₁ q̇₁ / 2`` (the momentum the tendon's
+    force leaves alone: it pushes ``+f`` on the first and ``-2f`` on the second) is conserved."""
+    k = 3.0
+    art, tendon = _two_wheels(stiffness=k, springlength=0.0)
+    art.q = [0.2, 0.0]
+    omega = np.sqrt(k * (1 / 0.5 + 4 / 1.0))
+    trajectory = art.simulate(2.0, dt, integrator="rk4")
+    length = trajectory.q[:, 0] - 2.0 * trajectory.q[:, 1]
+    np.testing.assert_allclose(length, 0.2 * np.cos(omega * trajectory.time), atol=2e-3 * (dt * 240) ** 4 + 1e-9)
+    momentum = 0.5 * trajectory.qd[:, 0] + 0.5 * trajectory.qd[:, 1]
+    np.testing.assert_allclose(momentum, 0.0, atol=1e-12)
+    assert art.tendon_lengths()[0] == pytest.approx(length[-1], abs=1e-15)
+    assert art.tendons[tendon].springlength == 0.0
+
+
+def test_a_tendon_damper_and_an_actuator_on_a_tendon_pull_both_wheels():
+    """A motor on the tendon ``L = q₀ - 2 q₁`` pushes ``gear · c`` on the first wheel and ``-2 gear · c`` on the
+    second; a damper ``b`` adds ``-b L̇`` along ``L``. The spring length defaults to the length at the start."""
+    art, tendon = _two_wheels(damping=0.4)
+    art.q = [0.3, 0.1]
+    assert art.tendons[tendon].springlength == 0.0  # the length when the tendon was added
+    motor = art.add_actuator(tendon=tendon, gear=1.5)
+    art.ctrl = [0.8]
+    art.qd = [1.0, -0.5]  # L̇ = 2
+    force = 1.5 * 0.8 - 0.4 * 2.0
+    np.testing.assert_allclose(art.forward_dynamics(), [force / 0.5, -2.0 * force / 1.0], rtol=1e-14)
+    np.testing.assert_allclose(art.actuator_forces(), [0.8])
+    assert art.actuators[motor].tendon == tendon and art.actuators[motor].link is None

@@ -114,6 +114,14 @@ def test_bad_articulations_are_refused():
     driven.add_actuator(driven.add_link(Revolute((0, 1, 0)), shape=ROD, mass=1.0), gear=3.0)
     with pytest.raises(ValueError, match="the articulation has 1 actuators: world joints have none"):
         world.add_articulation(driven)
+    limited = Articulation()
+    limited.add_link(Revolute((0, 1, 0)), shape=ROD, mass=1.0, limits=(-1.0, 1.0), name="knee")
+    with pytest.raises(ValueError, match="link 'knee' has joint limits or frictionloss"):
+        world.add_articulation(limited)
+    tendon = Articulation()
+    tendon.add_tendon([tendon.add_link(Revolute((0, 1, 0)), shape=ROD, mass=1.0)], [1.0], stiffness=2.0)
+    with pytest.raises(ValueError, match="the articulation has 1 tendons: world joints have none"):
+        world.add_articulation(tendon)
     assert world.bodies == [] and world.joints == []
 
 

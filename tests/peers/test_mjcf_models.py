@@ -124,7 +124,9 @@ def _load(name: str, mujocos_mesh_inertia: bool = False):
     (with ``mujocos_mesh_inertia``, a model with mesh geoms is built on MuJoCo's compiled inertias)."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", MJCFWarning)
-        art, description = from_mjcf(_source(name)), read_mjcf(_source(name))
+        description = read_mjcf(_source(name))
+    # the tree's dynamics alone: limits, dry friction and tendons' springs are compared in test_mjcf_joint_physics.py
+    art = to_articulation(_without_constraints(description))
     spec = mujoco.MjSpec.from_string(EXERCISE) if name == "exercise" else mujoco.MjSpec.from_file(_source(name))
     for joint in spec.joints:
         joint.frictionloss = 0.0
@@ -144,18 +146,29 @@ def _load(name: str, mujocos_mesh_inertia: bool = False):
         model = spec.compile()
     assert len(art.actuators) == len(driven)
     if mujocos_mesh_inertia and any(_mesh_density(spec).values()):
-        art = to_articulation(_with_mujocos_inertia(description, model))
+        art = to_articulation(_without_constraints(_with_mujocos_inertia(description, model)))
     return art, description, model
 
 
+def _without_constraints(description):
+    """The description with its joints' and tendons' limits and dry friction, and its tendons' springs, taken out."""
+    bodies = tuple(replace(body, joints=tuple(replace(j, range=None, frictionloss=0.0) for j in body.joints))
+                   for body in description.bodies)  # fmt: skip
+    tendons = tuple(replace(t, range=None, frictionloss=0.0, stiffness=0.0, damping=0.0) for t in description.tendons)
+    return replace(description, bodies=bodies, tendons=tendons)
+
+
 def _driven(model) -> list[int]:
-    """MuJoCo's actuators that tumble simulates: on a hinge or slide, fixed gain, affine bias or none, no activation
-    dynamics (in the model's order, as ``art.ctrl``)."""
-    joint = int(mujoco.mjtTrn.mjTRN_JOINT)
+    """MuJoCo's actuators that tumble simulates: on a hinge, a slide or a fixed tendon, fixed gain, affine bias or
+    none, no activation dynamics (in the model's order, as ``art.ctrl``)."""
+    joint, tendon = int(mujoco.mjtTrn.mjTRN_JOINT), int(mujoco.mjtTrn.mjTRN_TENDON)
     hinge, slide = int(mujoco.mjtJoint.mjJNT_HINGE), int(mujoco.mjtJoint.mjJNT_SLIDE)
     affine = (int(mujoco.mjtBias.mjBIAS_NONE), int(mujoco.mjtBias.mjBIAS_AFFINE))
     return [i for i in range(model.nu)
-            if model.actuator_trntype[i] == joint and model.jnt_type[model.actuator_trnid[i, 0]] in (hinge, slide)
+            if ((model.actuator_trntype[i] == joint and model.jnt_type[model.actuator_trnid[i, 0]] in (hinge, slide))
+                or (model.actuator_trntype[i] == tendon and model.tendon_num[model.actuator_trnid[i, 0]] > 0
+                    and model.wrap_type[model.tendon_adr[model.actuator_trnid[i, 0]]]
+                    == int(mujoco.mjtWrap.mjWRAP_JOINT)))
             and model.actuator_dyntype[i] == int(mujoco.mjtDyn.mjDYN_NONE)
             and model.actuator_gaintype[i] == int(mujoco.mjtGain.mjGAIN_FIXED)
             and model.actuator_biastype[i] in affine]  # fmt: skip
@@ -256,15 +269,16 @@ def test_link_frames_mass_matrix_and_accelerations_equal_mujocos(name):
 
 
 def test_the_warnings_name_what_is_not_simulated_once_each_with_its_line():
-    with pytest.warns(MJCFWarning) as record:
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", MJCFWarning)  # the humanoid's limits, tendons and 17 motors are all simulated
         humanoid = from_mjcf(os.path.join(ASSETS, "humanoid.xml"))
+    assert len(humanoid.actuators) == 17 and len(humanoid.tendons) == 2
+    with pytest.warns(MJCFWarning) as record:
+        from_mjcf(os.path.join(SUITE_DIR, "dog.xml"))
     messages = [str(w.message) for w in record]
     assert len(messages) == len(set(messages))
-    assert any("<joint> range (line " in m and "more)" in m for m in messages)
-    assert any("<tendon> element (line " in m for m in messages)
-    assert not any("<motor>" in m or "<actuator>" in m for m in messages)  # its 17 motors are loaded
-    assert len(humanoid.actuators) == 17
-    assert all("humanoid.xml" in m for m in messages)
+    assert any("<general> element (line " in m and "more)" in m and "dyntype" in m for m in messages)
+    assert all("dog.xml" in m for m in messages)
 
 
 # Models tuned for MuJoCo's Euler, whose damping is implicit: without their contacts and limits, a light link behind

@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from tumble.articulation import Articulation, Ball, Fixed, Free, Prismatic, Revolute
+from tumble.articulation import Articulation, Ball, Fixed, Free, Prismatic, Revolute, SoftConstraint
 from tumble.errors import SimulationError
 from tumble.mass import MassProperties
 from tumble.shapes import Box, Sphere
@@ -105,6 +105,11 @@ def test_bad_parent(parent, error, message):
         ({"damping": -0.1}, ValueError, r"damping must be >= 0, got -0.1"),
         ({"name": 3}, TypeError, r"name must be a string or None, got 3"),
         ({"name": "arm"}, ValueError, r"name must be unique, got 'arm' \(link 0 has it\)"),
+        ({"limits": (1.0, -1.0)}, ValueError, r"limits must be \(lower, upper\) with lower <= upper, got \(1.0, -1"),
+        ({"limits": (0.0, math.inf)}, ValueError, r"limits must be finite"),
+        ({"margin": -0.1}, ValueError, r"margin must be >= 0, got -0.1"),
+        ({"frictionloss": -1.0}, ValueError, r"frictionloss must be >= 0, got -1.0"),
+        ({"limit_softness": (0.02, 1.0)}, TypeError, r"limit_softness must be a SoftConstraint or None"),
     ],
 )
 def test_bad_link_arguments(kwargs, error, message):
@@ -318,3 +323,82 @@ def test_import_tumble_loads_the_articulation_only_when_used():
     )
     result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert result.returncode == 0, result.stderr
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "error", "message"),
+    [
+        ({"solref": (0.02, -1.0)}, ValueError, r"solref must be two positive numbers or two numbers <= 0"),
+        ({"solref": (0.02,)}, ValueError, r"solref must have shape \(2\)"),
+        ({"solimp": (0.9, 0.95, -0.001, 0.5, 2.0)}, ValueError, r"solimp's width .* must be >= 0"),
+        ({"solimp": (0.9, math.nan, 0.001, 0.5, 2.0)}, ValueError, r"solimp must be finite"),
+    ],
+)
+def test_bad_soft_constraints(kwargs, error, message):
+    with pytest.raises(error, match=message):
+        SoftConstraint(**kwargs)
+
+
+def test_soft_constraints_clamp_as_mujoco_does():
+    soft = SoftConstraint(solimp=(0.0, 1.5, 0.01, 2.0, 0.5))
+    assert soft.solimp == (1e-4, 0.9999, 0.01, 0.9999, 1.0)
+
+
+def test_limits_on_a_ball_and_loop_closures_with_limits_are_refused():
+    art = pendulum()
+    before = _state(art)
+    with pytest.raises(ValueError, match=r"limits=\(0.0, 1.0\) need a Revolute or Prismatic joint, got Ball"):
+        art.add_link(Ball(), parent=1, limits=(0.0, 1.0), mass=1.0)
+    with pytest.raises(ValueError, match="loop closures are not simulated with limits"):
+        limited = Articulation()
+        limited.add_link(Revolute((0, 1, 0)), mass=1.0, shape_position=(0, 0, -1), limits=(-1.0, 1.0))
+        limited.add_loop_closure(0, (0, 0, -1), None, (0, 0, -1))
+    looped = Articulation()
+    looped.add_link(Revolute((0, 1, 0)), mass=1.0, shape_position=(0, 0, -1))
+    looped.add_link(Revolute((0, 1, 0)), parent=0, position=(0, 0, -1), mass=1.0, shape_position=(0, 0, -1))
+    looped.add_loop_closure(1, (0, 0, -1), None, (0, 0, -2))
+    with pytest.raises(ValueError, match="limits and frictionloss are not simulated with loop closures"):
+        looped.add_link(Revolute((0, 1, 0)), parent=1, frictionloss=1.0, mass=1.0)
+    with pytest.raises(ValueError, match="tendons are not simulated with loop closures"):
+        looped.add_tendon([0, 1], [1.0, -1.0])
+    assert art.link_count == 2 and looped.link_count == 2 and looped.tendons == ()
+    _unchanged(art, before)
+
+
+@pytest.mark.parametrize(
+    ("args", "kwargs", "error", "message"),
+    [
+        (([], []), {}, ValueError, r"links must be a non-empty sequence of link indices, got \[\]"),
+        (([0, 1], [1.0, 1.0]), {}, ValueError, r"links: link 1 has a Ball\(\) joint; a tendon runs over"),
+        (([0, 5], [1.0, 1.0]), {}, ValueError, r"links must be"),
+        (([0], [1.0, 2.0]), {}, ValueError, r"coefficients must have shape \(1\)"),
+        (([0], [1.0]), {"limits": (2.0, 1.0)}, ValueError, r"limits must be \(lower, upper\)"),
+        (([0], [1.0]), {"stiffness": -1.0}, ValueError, r"stiffness must be >= 0, got -1.0"),
+        (([0], [1.0]), {"damping": -1.0}, ValueError, r"damping must be >= 0, got -1.0"),
+        (([0], [1.0]), {"springlength": math.nan}, ValueError, r"springlength must be finite"),
+        (([0], [1.0]), {"name": 3}, TypeError, r"name must be a string or None, got 3"),
+    ],
+)
+def test_bad_tendons(args, kwargs, error, message):
+    art = pendulum()
+    with pytest.raises(error, match=message):
+        art.add_tendon(*args, **kwargs)
+    assert art.tendons == ()
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "error", "message"),
+    [
+        ({}, ValueError, r"give one of link and tendon, got link=None and tendon=None"),
+        ({"link": 0, "tendon": 0}, ValueError, r"give one of link and tendon"),
+        ({"tendon": 1}, ValueError, r"tendon must be the index of a tendon \(0..0\), got 1"),
+        ({"link": 0, "force_range": (1.0, -1.0)}, ValueError, r"force_range must be \(low, high\) with low <= high"),
+        ({"link": 0, "ctrl_range": (1.0, -1.0)}, ValueError, r"ctrl_range must be \(low, high\) with low <= high"),
+    ],
+)
+def test_bad_actuators(kwargs, error, message):
+    art = pendulum()
+    art.add_tendon([0], [2.0])
+    with pytest.raises(error, match=message):
+        art.add_actuator(**kwargs)
+    assert art.actuators == () and art.ctrl.shape == (0,)

@@ -310,3 +310,17 @@ def test_an_articulation_with_actuators_is_refused():
     art.add_actuator(art.add_link(Revolute((0, 1, 0)), mass=1.0, shape_position=(0.0, 0.0, -1.0)), gear=2.0)
     with pytest.raises(ValueError, match=r"articulation has 1 actuators, which the symbolic derivation"):
         lagrange.from_articulation(art)
+
+
+def test_an_articulation_with_limits_friction_or_tendons_is_refused():
+    from tumble.articulation import Articulation, Revolute
+
+    for link_settings in ({"limits": (-1.0, 1.0)}, {"frictionloss": 0.5}):
+        art = Articulation()
+        art.add_link(Revolute((0, 1, 0)), mass=1.0, shape_position=(0.0, 0.0, -1.0), name="arm", **link_settings)
+        with pytest.raises(ValueError, match=r"link 0 \('arm'\) has joint limits or frictionloss"):
+            lagrange.from_articulation(art)
+    art = Articulation()
+    art.add_tendon([art.add_link(Revolute((0, 1, 0)), mass=1.0, shape_position=(0.0, 0.0, -1.0))], [1.0])
+    with pytest.raises(ValueError, match=r"articulation has 1 tendons, which the symbolic derivation"):
+        lagrange.from_articulation(art)

@@ -80,16 +80,15 @@ def test_includes_are_found_beside_the_main_file_first_then_beside_the_including
 def test_each_unsupported_element_and_attribute_warns_once_with_its_first_line_and_count():
     text = model(
         '<body>\n<joint frictionloss="1" damping="0.1"/>\n<joint frictionloss="2" bogus="3"/><geom size="1"/></body>',
-        "<tendon/><sensor/>",
+        "<tendon><spatial/><spatial/></tendon><sensor/>",
     )
     with pytest.warns(MJCFWarning) as record:
         from_mjcf(text)
     messages = sorted(str(w.message) for w in record)
     assert messages == [
         "<string>: <joint> bogus (line 3): not supported by tumble; ignored",
-        "<string>: <joint> frictionloss (line 2 and 1 more): not simulated by tumble's Articulation (yet); ignored",
         "<string>: <sensor> element (line 1): not loaded by tumble (yet); ignored",
-        "<string>: <tendon> element (line 1): not loaded by tumble (yet); ignored",
+        "<string>: <spatial> element (line 1 and 1 more): tumble loads fixed tendons only; not loaded",
     ]
 
 
@@ -241,23 +240,24 @@ def test_motors_servos_and_general_actuators_read_with_their_default_classes():
 @pytest.mark.parametrize(
     ("actuators", "match"),
     [
-        ('<motor tendon="t"/>', r"<motor> tendon \(line 6\): tumble drives joints only; this actuator is not loaded"),
+        ('<motor site="s"/>', r"<motor> site \(line 6\): tumble drives joints and fixed tendons only; not loaded"),
         ('<motor joint="twist"/>', r"<motor> joint .*tumble drives hinges and slides, not a ball; not loaded"),
         ('<general joint="shoulder" dyntype="filter"/>', r"<general> element .*dyntype='filter': activation dynamics"),
         ('<muscle joint="shoulder"/>', r"<muscle> element .*this actuator is not simulated by tumble; not loaded"),
-        ('<motor joint="shoulder" forcerange="-1 1"/>', r"<motor> forcerange .*not clipped by tumble"),
     ],
 )  # fmt: skip
 def test_actuators_tumble_does_not_simulate_are_named_and_not_loaded(actuators, match):
     with pytest.warns(MJCFWarning, match=match):
         description = read_mjcf(arm(actuators))
-    assert len(description.actuators) == (1 if "forcerange" in actuators else 0)
+    assert len(description.actuators) == 0
 
 
 @pytest.mark.parametrize(
     ("actuators", "autolimits", "match"),
     [
         ('<motor joint="elbow"/>', "true", r"line 6, <motor>: joint='elbow' names no joint"),
+        ('<motor tendon="t"/>', "true", r"line 6, <motor>: tendon='t' names no fixed tendon"),
+        ('<motor joint="shoulder" tendon="t"/>', "true", r"line 6, <motor>: an actuator has one transmission"),
         ('<motor joint="shoulder" ctrlrange="1 -1"/>', "true", r"ctrlrange='1 -1' must have its lower bound below"),
         ('<velocity joint="shoulder" ctrlrange="-1 1"/>', "false", r"ctrlrange without ctrllimited=\.\.\. needs "
          "compiler autolimits"),

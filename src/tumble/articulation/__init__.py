@@ -18,6 +18,7 @@ from .actuators import Actuator
 from .articulation import Articulation, ArticulationTrajectory, Link
 from .batch import ArticulationBatch
 from .joints import Ball, Fixed, Free, Joint, JointType, Prismatic, Revolute
+from .limits import SoftConstraint, Tendon
 from .loops import LoopClosure
 
 
@@ -61,6 +62,8 @@ __all__ = [
     "LoopClosure",
     "Prismatic",
     "Revolute",
+    "SoftConstraint",
+    "Tendon",
     "from_mjcf",
     "from_urdf",
 ]

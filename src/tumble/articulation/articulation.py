@@ -30,16 +30,18 @@ from ..errors import SimulationError
 from ..mass import MassProperties
 from ..rotation import quat_from_rotvec, quat_multiply, quat_to_matrix
 from ..shapes import Shape
-from .actuators import Actuator, actuator_forces, drive_columns
+from .actuators import Actuator
+from .drives import JointDrives, softness
 from .integrators import EULER, NOT_FINITE, RK4, SYMPLECTIC
 from .joints import Ball, Free, Joint, Prismatic, Revolute
 from .kernels import FORWARD, INVERSE, KINEMATICS, MASS_MATRIX, PROJECT, SIMULATE, articulation_kernel
+from .limits import SoftConstraint, Tendon, actuator_rows, check_limits, invweights, readonly, scalar_rows
 from .loops import LoopClosure
 from .model import (
     DOF_PARENT,
     DOF_TIP,
-    DRIVE,
     INERTIA_WORLD,
+    INVWEIGHT,
     LOOP_ERROR,
     POS,
     QUAT,
@@ -52,16 +54,10 @@ from .model import (
     work_views,
 )
 
-__all__ = ["Actuator", "Articulation", "ArticulationTrajectory", "Link"]
+__all__ = ["Actuator", "Articulation", "ArticulationTrajectory", "Link", "SoftConstraint", "Tendon"]
 
 INTEGRATORS = {"euler": EULER, "symplectic": SYMPLECTIC, "rk4": RK4}
 LOOP_KINDS = ("point",)
-
-
-def _readonly(values) -> np.ndarray:
-    array = np.array(values, dtype=np.float64)
-    array.flags.writeable = False
-    return array
 
 
 @dataclass(frozen=True, eq=False)
@@ -78,6 +74,9 @@ class Link:
         shape, shape_position, shape_orientation: the geometry, if any, in the link frame.
         armature: inertia added to each of the joint's degrees of freedom (a motor's rotor, as MuJoCo's).
         stiffness, springref: a spring ``-stiffness (q - springref)`` on a revolute or prismatic joint.
+        limits: ``(lower, upper)`` of a revolute or prismatic joint's coordinate, or ``None``; margin: the distance
+            from a limit at which it starts to act; frictionloss: the dry friction on each degree of freedom;
+            limit_softness, friction_softness: their :class:`SoftConstraint` (MuJoCo's ``solref``/``solimp``).
     """
 
     index: int
@@ -91,11 +90,16 @@ class Link:
     q_slice: slice
     v_slice: slice
     shape: Shape | None = None
-    shape_position: np.ndarray = field(default_factory=lambda: _readonly((0.0, 0.0, 0.0)))
-    shape_orientation: np.ndarray = field(default_factory=lambda: _readonly((1.0, 0.0, 0.0, 0.0)))
+    shape_position: np.ndarray = field(default_factory=lambda: readonly((0.0, 0.0, 0.0)))
+    shape_orientation: np.ndarray = field(default_factory=lambda: readonly((1.0, 0.0, 0.0, 0.0)))
     armature: float = 0.0
     stiffness: float = 0.0
     springref: float = 0.0
+    limits: tuple[float, float] | None = None
+    margin: float = 0.0
+    frictionloss: float = 0.0
+    limit_softness: SoftConstraint = field(default_factory=SoftConstraint)
+    friction_softness: SoftConstraint = field(default_factory=SoftConstraint)
 
 
 @dataclass(frozen=True, eq=False)
@@ -139,7 +143,7 @@ class _Compiled:
         return model, python_function(work_views)(self.work, *counts(self.ints))
 
 
-class Articulation:
+class Articulation(JointDrives):
     """A tree of rigid links joined by joints, in generalised coordinates.
 
     Args:
@@ -173,13 +177,15 @@ class Articulation:
         self._compiled: _Compiled | None = None
         self._actuators: list[Actuator] = []
         self._ctrl = np.zeros(0)
+        self._tendons: list[Tendon] = []
 
     # --- building ------------------------------------------------------------------------------------
 
     def add_link(self, joint, *, parent=None, position=(0.0, 0.0, 0.0), orientation=(1.0, 0.0, 0.0, 0.0),
                  shape=None, mass=None, density=None, mass_properties=None, shape_position=(0.0, 0.0, 0.0),
                  shape_orientation=(1.0, 0.0, 0.0, 0.0), damping=0.0, name=None, armature=0.0, stiffness=0.0,
-                 springref=0.0) -> int:  # fmt: skip
+                 springref=0.0, limits=None, margin=0.0, frictionloss=0.0, limit_softness=None,
+                 friction_softness=None) -> int:  # fmt: skip
         """Add a link joined to ``parent`` by ``joint``; returns its index.
 
         Args:
@@ -200,15 +206,21 @@ class Articulation:
                 inertia of a motor's rotor, on the mass matrix's diagonal (MuJoCo's ``armature``).
             stiffness: >= 0, springref: a spring ``-stiffness (q - springref)`` on a ``Revolute`` or ``Prismatic``
                 joint; its energy counts in ``potential_energy``.
+            limits: ``(lower, upper)`` [rad or m] of a ``Revolute`` or ``Prismatic`` joint's coordinate, or ``None``;
+                each acts once the coordinate is within ``margin`` >= 0 of it, as a soft constraint with
+                ``limit_softness`` (a :class:`SoftConstraint`, default MuJoCo's ``solref``/``solimp``).
+            frictionloss: >= 0, dry friction [N m or N] on each of the joint's degrees of freedom: a constraint force
+                of at most that much against the motion, soft as ``friction_softness`` says (MuJoCo's joint
+                ``frictionloss``; ``constraints.py``).
         """
         if not isinstance(joint, Joint):
             raise TypeError(f"joint must be a Revolute, Prismatic, Ball, Free or Fixed, got {_show(joint)}")
         index = len(self._links)
         parent = self._check_parent(parent, index)
-        position = _readonly(as_vector3("position", position))
-        orientation = _readonly(as_quaternion("orientation", orientation))
-        shape_position = _readonly(as_vector3("shape_position", shape_position))
-        shape_orientation = _readonly(as_quaternion("shape_orientation", shape_orientation))
+        position = readonly(as_vector3("position", position))
+        orientation = readonly(as_quaternion("orientation", orientation))
+        shape_position = readonly(as_vector3("shape_position", shape_position))
+        shape_orientation = readonly(as_quaternion("shape_orientation", shape_orientation))
         properties = _mass_properties(shape, mass, density, mass_properties, shape_position, shape_orientation)
         damping = as_float("damping", damping, nonnegative=True)
         armature = as_float("armature", armature, nonnegative=True)
@@ -216,6 +228,16 @@ class Articulation:
         springref = as_float("springref", springref)
         if stiffness != 0.0 and not isinstance(joint, (Revolute, Prismatic)):
             raise ValueError(f"stiffness={stiffness!r} needs a Revolute or Prismatic joint, got {joint!r}")
+        limits = check_limits("limits", limits)
+        if limits is not None and not isinstance(joint, (Revolute, Prismatic)):
+            raise ValueError(f"limits={limits!r} need a Revolute or Prismatic joint, got {joint!r}")
+        margin = as_float("margin", margin, nonnegative=True)
+        frictionloss = as_float("frictionloss", frictionloss, nonnegative=True)
+        limit_softness = softness("limit_softness", limit_softness)
+        friction_softness = softness("friction_softness", friction_softness)
+        if (limits is not None or frictionloss > 0.0) and self._loops:
+            raise ValueError("limits and frictionloss are not simulated with loop closures (yet); this articulation "
+                             "has loop closures")  # fmt: skip
         if name is not None and not isinstance(name, str):
             raise TypeError(f"name must be a string or None, got {_show(name)}")
         if name is not None and any(link.name == name for link in self._links):
@@ -223,17 +245,14 @@ class Articulation:
         nq, nv = self.nq, self.nv
         link = Link(index, name, parent, joint, position, orientation, properties, damping,
                     slice(nq, nq + joint.nq), slice(nv, nv + joint.nv), shape, shape_position,
-                    shape_orientation, armature, stiffness, springref)  # fmt: skip
-        # the joint's initial coordinates: zero displacement
-        initial = np.zeros(joint.nq)
+                    shape_orientation, armature, stiffness, springref, limits, margin, frictionloss, limit_softness,
+                    friction_softness)  # fmt: skip
         if isinstance(joint, Ball):
-            initial[:] = (1.0, 0.0, 0.0, 0.0)
             self._quat_starts.append((nq, index))
         elif isinstance(joint, Free):
-            initial[:3], initial[3:] = position, orientation
             self._quat_starts.append((nq + 3, index))
         self._links.append(link)
-        self._q = np.concatenate([self._q, initial])
+        self._q = np.concatenate([self._q, _initial_coordinates(link)])
         self._qd = np.concatenate([self._qd, np.zeros(joint.nv)])
         self._compiled = None
         return index
@@ -254,72 +273,17 @@ class Articulation:
             raise ValueError(f"link_b must differ from link_a, got both {link_a}")
         if not isinstance(kind, str) or kind not in LOOP_KINDS:
             raise ValueError(f"kind must be one of {LOOP_KINDS}, got {_show(kind)}")
-        loop = LoopClosure(len(self._loops), link_a, _readonly(as_vector3("point_a", point_a)), link_b,
-                           _readonly(as_vector3("point_b", point_b)), kind)  # fmt: skip
+        if self._has_soft_constraints():
+            raise ValueError("loop closures are not simulated with limits, frictionloss or tendons (yet); this "
+                             "articulation has some")  # fmt: skip
+        loop = LoopClosure(len(self._loops), link_a, readonly(as_vector3("point_a", point_a)), link_b,
+                           readonly(as_vector3("point_b", point_b)), kind)  # fmt: skip
         self._loops.append(loop)
         self._compiled = None
         return loop.index
 
-    def add_actuator(self, link, *, gear=1.0, gain=1.0, bias=(0.0, 0.0, 0.0), ctrl_range=None, name=None) -> int:
-        """Drive ``link``'s Revolute or Prismatic joint from ``ctrl``; returns the actuator's index in ``ctrl``.
-
-        The actuator pulls along its length ``l = gear · q`` with ``f = gain · c + bias[0] + bias[1] l + bias[2] l̇``
-        (``c`` the control, clipped to ``ctrl_range``) and pushes the joint with ``gear · f``: a motor is the
-        default (``gear · ctrl``), a position servo ``gain=kp, bias=(0, -kp, -kv)``, a velocity servo ``gain=kv,
-        bias=(0, 0, -kv)`` (MuJoCo's actuators on a joint; see ``actuators.py``). Its control starts at 0.
-
-        Args:
-            link: a link index; gear, gain: finite; bias: (3,); ctrl_range: ``(low, high)`` with low <= high, or
-                ``None``; name: optional unique label.
-        """
-        link = self._check_link("link", link)
-        joint = self._links[link].joint
-        if not isinstance(joint, (Revolute, Prismatic)):
-            raise ValueError(f"link {link} has a {joint!r} joint: an actuator drives a Revolute or Prismatic one")
-        gear, gain = as_float("gear", gear), as_float("gain", gain)
-        bias = _readonly(as_array("bias", bias, (3,), batch=False))
-        if ctrl_range is not None:
-            low, high = (float(v) for v in as_array("ctrl_range", ctrl_range, (2,), batch=False))
-            if not low <= high:
-                raise ValueError(f"ctrl_range must be (low, high) with low <= high, got {_show(ctrl_range)}")
-            ctrl_range = (low, high)
-        if name is not None and not isinstance(name, str):
-            raise TypeError(f"name must be a string or None, got {_show(name)}")
-        if name is not None and any(a.name == name for a in self._actuators):
-            raise ValueError(f"name must be unique among the actuators, got {name!r}")
-        self._actuators.append(Actuator(len(self._actuators), name, link, gear, gain, bias, ctrl_range))
-        self._ctrl = np.append(self._ctrl, 0.0)
-        self._compiled = None
-        return len(self._actuators) - 1
-
-    @property
-    def actuators(self) -> tuple[Actuator, ...]:
-        return tuple(self._actuators)
-
-    @property
-    def ctrl(self) -> np.ndarray:
-        """(number of actuators,) the controls (a copy), held until set again; clipped to each actuator's
-        ``ctrl_range`` where it acts, kept as given here."""
-        return self._ctrl.copy()
-
-    @ctrl.setter
-    def ctrl(self, value) -> None:
-        self._ctrl = self._check_vector("ctrl", value, len(self._actuators))
-        if self._compiled is not None:
-            self._compiled.views()[0].dof_params[:, DRIVE:] = self._drives()
-
-    def actuator_forces(self, q=None, qd=None) -> np.ndarray:
-        """Each actuator's force along its length at the state (default the current one), before its gear:
-        MuJoCo's ``actuator_force``."""
-        q = self._q if q is None else self._check_q("q", q)
-        qd = self._qd if qd is None else self._check_vector("qd", qd, self.nv)
-        links = [self._links[a.link] for a in self._actuators]
-        return actuator_forces(self._actuators, [link.v_slice.start for link in links],
-                               [link.q_slice.start for link in links], self._ctrl, q, qd)  # fmt: skip
-
-    def _drives(self) -> np.ndarray:
-        dofs = [self._links[a.link].v_slice.start for a in self._actuators]
-        return drive_columns(self._actuators, dofs, self._ctrl, self.nv)
+    def _has_soft_constraints(self) -> bool:
+        return bool(self._tendons) or any(link.limits is not None or link.frictionloss > 0.0 for link in self._links)
 
     # --- description -----------------------------------------------------------------------------------
 
@@ -592,14 +556,29 @@ class Articulation:
 
     def _compile(self) -> _Compiled:
         if self._compiled is None:
+            nq, nv = self.nq, self.nv
+            actuated = {a.link for a in self._actuators if a.link is not None}
+            scalars, link_scalar, tendon_scalar = scalar_rows(self._links, self._tendons, actuated, nq, nv)
+            rows = actuator_rows(self._actuators, lambda a: link_scalar[a.link] if a.tendon is None
+                                 else tendon_scalar[a.tendon], self._ctrl)  # fmt: skip
             ints, reals = pack_model(self._links, self._loops, self._gravity, self._base_position,
-                                     self._base_orientation, self._drives())  # fmt: skip
-            n, nq, nv, nl = counts(ints)
+                                     self._base_orientation, scalars, rows)  # fmt: skip
+            n, nq, nv, nl, ns = counts(ints)
             self._compiled = _Compiled(
-                ints, reals, np.zeros(work_size(n, nq, nv, nl)), np.zeros(nv), np.zeros((n, 6)), np.zeros(nv),
+                ints, reals, np.zeros(work_size(n, nq, nv, nl, ns)), np.zeros(nv), np.zeros((n, 6)), np.zeros(nv),
                 np.zeros((0, nq + nv + 1)),
             )  # fmt: skip
+            if ns:
+                model = self._compiled.views()[0]
+                model.scalar_reals[:, INVWEIGHT] = invweights(self._links, model.scalar_v, self._initial_mass_matrix())
         return self._compiled
+
+    def _initial_mass_matrix(self) -> np.ndarray:
+        """``H`` at the links' zero displacement (a free joint at its initial pose): MuJoCo's ``qpos0``, where it
+        weighs its constraints (``invweight0``)."""
+        initial = np.concatenate([_initial_coordinates(link) for link in self._links])
+        _, w = self._evaluate(MASS_MATRIX, q=initial, qd=self._compiled.zero_v)
+        return w.mass_matrix.copy()
 
     def _evaluate(self, mode, *, q=None, qd=None, vec_in=None, external=None, require_all=False):
         """Validate the state arguments, run one query of the kernel and return the model and work views."""
@@ -692,6 +671,16 @@ def unit_quaternions(name: str, q: np.ndarray, quat_starts) -> np.ndarray:
                              f"got {_show(quat[bad])}")  # fmt: skip
         quat /= norms[:, None]
     return q
+
+
+def _initial_coordinates(link: Link) -> np.ndarray:
+    """A new link's coordinates: zero displacement (the identity for a ball; a free joint's initial pose)."""
+    initial = np.zeros(link.joint.nq)
+    if isinstance(link.joint, Ball):
+        initial[:] = (1.0, 0.0, 0.0, 0.0)
+    elif isinstance(link.joint, Free):
+        initial[:3], initial[3:] = link.position, link.orientation
+    return initial
 
 
 def _check_integrator(integrator) -> int:

@@ -26,9 +26,6 @@ from .model import (
     DAMPING,
     DOF_LINK,
     DOF_PARENT,
-    DRIVE,
-    DRIVE_Q,
-    DRIVE_QD,
     FORCE,
     GRAVITY,
     INERTIA_WORLD,
@@ -88,13 +85,12 @@ def joint_energies(link_ints, dof_params, q, qd):
 
 @inline
 def joint_force(dof_params, k, q_value, qd_value):
-    """The joint's own force against degree of freedom ``k``: ``damping q̇ + stiffness (q - springref)`` less its
-    actuators' drive ``DRIVE + DRIVE_Q q + DRIVE_QD q̇`` (springs and actuators only on a hinge or slide, whose
-    coordinate ``q_value`` is its own; elsewhere those columns are zero)."""
+    """The joint's own force against degree of freedom ``k``: ``damping q̇ + stiffness (q - springref)`` (springs
+    only on a hinge or slide, whose coordinate ``q_value`` is its own; elsewhere the stiffness is zero)."""
     force = dof_params[k, DAMPING] * qd_value
     if dof_params[k, STIFFNESS] != 0.0:
         force += dof_params[k, STIFFNESS] * (q_value - dof_params[k, SPRINGREF])
-    return force - (dof_params[k, DRIVE] + dof_params[k, DRIVE_Q] * q_value + dof_params[k, DRIVE_QD] * qd_value)
+    return force
 
 
 @inline

@@ -12,8 +12,10 @@ on the configuration manifold with :func:`~.kinematics.integrate_configuration`,
   scheme is only second order for rotations; with it, it is fourth order and agrees with MuJoCo's RK4 to
   rounding.
 
-After the step, loop closures are projected back onto their manifold, and a non-finite result is rolled
-back (``q``, ``q̇`` keep their values from before the step).
+Each evaluation adds the actuators' and tendons' forces to the joint forces and, where the model has limits or dry
+friction, solves them (``constraints.py``) at that stage's state, as MuJoCo's RK4 does. After the step, loop closures
+are projected back onto their manifold, and a non-finite result is rolled back (``q``, ``q̇`` keep their values from
+before the step).
 """
 
 from __future__ import annotations
@@ -23,6 +25,7 @@ import math
 from .._jit import inline
 from ..math3d import add, add_scaled, cross, scale
 from .aba import aba
+from .constraints import applied_forces, constrained, solve_constraints
 from .dynamics import crba, ltdl_factor, ltdl_solve, rnea
 from .joints import JointType
 from .kinematics import forward_kinematics, integrate_configuration
@@ -52,17 +55,20 @@ _FREE = int(JointType.FREE)
 
 
 @inline
-def accelerations(m, w, q, qd, tau, external, use_external):
+def accelerations(m, w, q, qd, tau, external, use_external, step_size):
     """``q̈`` into ``w.dof_work[QDD]`` for the state ``(q, qd)`` under joint forces ``tau`` (nv,).
 
-    A tree takes the articulated-body algorithm (``aba.py``, O(n)). With loop closures: bias forces by RNEA,
-    ``H`` by CRBA, its LTDL factor (left in ``w.mass_matrix`` for the projection), the solve, then the
-    loop-closure correction (``loops.py``). Returns -1, or the row of a singular pivot.
+    A tree without limits or dry friction takes the articulated-body algorithm (``aba.py``, O(n)). Otherwise: bias
+    forces by RNEA, ``H`` by CRBA, its LTDL factor (left in ``w.mass_matrix`` for the projection), the solve, then
+    the constraints (``constraints.py``, whose time constants are kept above twice ``step_size``; 0 for a query)
+    and the loop-closure correction (``loops.py``). Returns -1, or the row of a singular pivot.
     """
     link_ints, world, dof_params = m.link_ints, m.world, m.dof_params
     link_work, dof_motion, dof_work, h = w.link_work, w.dof_motion, w.dof_work, w.mass_matrix
     forward_kinematics(link_ints, m.link_reals, world, q, qd, link_work, dof_motion)
-    if m.loop_ints.shape[0] == 0:
+    tau = applied_forces(m, w, q, qd, tau)
+    limited = constrained(m)
+    if m.loop_ints.shape[0] == 0 and not limited:
         return aba(link_ints, world, dof_params, link_work, dof_motion, w.dof_u, dof_work[DIAG], q, qd, tau,
                    external, use_external, dof_work[QDD])  # fmt: skip
     at_rest = dof_work[RHS]  # the bias forces are the joint forces at q̈ = 0
@@ -76,8 +82,12 @@ def accelerations(m, w, q, qd, tau, external, use_external):
     for k in range(qdd.shape[0]):
         qdd[k] = tau[k] - bias[k]
     ltdl_solve(m.dof_ints, h, qdd)
-    loop_jacobian(link_ints, m.dof_ints, m.loop_ints, m.loop_reals, link_work, dof_motion, w.loop_jac, w.loop_work)
-    solve_loop_closures(m.dof_ints, h, w.loop_jac, w.loop_minv_jt, w.loop_matrix, w.loop_work, qdd)
+    if limited:
+        solve_constraints(m, w, q, qd, h, step_size, qdd)
+    if m.loop_ints.shape[0] > 0:
+        loop_jacobian(link_ints, m.dof_ints, m.loop_ints, m.loop_reals, link_work, dof_motion, w.loop_jac,
+                      w.loop_work)  # fmt: skip
+        solve_loop_closures(m.dof_ints, h, w.loop_jac, w.loop_minv_jt, w.loop_matrix, w.loop_work, qdd)
     return -1
 
 
@@ -147,7 +157,7 @@ def step(m, w, q, qd, tau, external, use_external, h, method):
     nv = qd.shape[0]
     # a tree's evaluation is called here directly, with the arrays it needs: passing the model and work
     # tuples through one more call per stage costs 10 % of a step of a 20-link chain
-    tree = m.loop_ints.shape[0] == 0
+    tree = m.loop_ints.shape[0] == 0 and not constrained(m)
     link_reals, world, dof_params = m.link_reals, m.world, m.dof_params
     link_work, dof_motion, dof_u, pivots = w.link_work, w.dof_motion, w.dof_u, dof_work[DIAG]
     if method == RK4:
@@ -160,10 +170,11 @@ def step(m, w, q, qd, tau, external, use_external, h, method):
         for stage in range(4):
             if tree:
                 forward_kinematics(link_ints, link_reals, world, q_stage, qd_stage, link_work, dof_motion)
-                bad = aba(link_ints, world, dof_params, link_work, dof_motion, dof_u, pivots, q_stage, qd_stage, tau,
-                          external, use_external, qdd)  # fmt: skip
+                forces = applied_forces(m, w, q_stage, qd_stage, tau)
+                bad = aba(link_ints, world, dof_params, link_work, dof_motion, dof_u, pivots, q_stage, qd_stage,
+                          forces, external, use_external, qdd)  # fmt: skip
             else:
-                bad = accelerations(m, w, q_stage, qd_stage, tau, external, use_external)
+                bad = accelerations(m, w, q_stage, qd_stage, tau, external, use_external, h)
             if bad >= 0:
                 assign(q, q_start)
                 assign(qd, qd_start)
@@ -187,16 +198,17 @@ def step(m, w, q, qd, tau, external, use_external, h, method):
     else:
         if tree:
             forward_kinematics(link_ints, link_reals, world, q, qd, link_work, dof_motion)
-            bad = aba(link_ints, world, dof_params, link_work, dof_motion, dof_u, pivots, q, qd, tau, external,
+            forces = applied_forces(m, w, q, qd, tau)
+            bad = aba(link_ints, world, dof_params, link_work, dof_motion, dof_u, pivots, q, qd, forces, external,
                       use_external, qdd)  # fmt: skip
         else:
-            bad = accelerations(m, w, q, qd, tau, external, use_external)
+            bad = accelerations(m, w, q, qd, tau, external, use_external, h)
         if bad >= 0:
             return SINGULAR, bad
         for k in range(nv):
             qd[k] += h * qdd[k]
         integrate_configuration(link_ints, q_start, qd_start if method == EULER else qd, h, q)
-    if not tree:
+    if m.loop_ints.shape[0] > 0:
         project_loop_closures(m, w, q, qd)
     bad = _first_bad_link(link_ints, q, qd)
     if bad >= 0:

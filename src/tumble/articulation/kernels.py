@@ -11,12 +11,13 @@ return status codes that the facade turns into errors.
 from __future__ import annotations
 
 from .._jit import inline, kernel
+from .constraints import applied_forces
 from .dynamics import crba, joint_energies, rnea
 from .integrators import accelerations, step
 from .kinematics import energies, forward_kinematics
 from .loops import loop_jacobian, project_loop_closures
-from .model import QDD, model_views, work_views
-from .spatial import assign, fill_matrix
+from .model import QDD, RHS, model_views, work_views
+from .spatial import assign, fill, fill_matrix
 
 __all__ = [
     "FORWARD",
@@ -62,9 +63,9 @@ def articulation_kernel(ints, reals, q, qd, vec_in, external, use_external, work
     ``SIMULATE`` only, the state is that before the failing step).
     """
     m = model_views(ints, reals)
-    w = work_views(work, ints[0], ints[1], ints[2], ints[3])
+    w = work_views(work, ints[0], ints[1], ints[2], ints[3], ints[4])
     if mode == FORWARD or mode == PROJECT:
-        bad = accelerations(m, w, q, qd, vec_in, external, use_external)
+        bad = accelerations(m, w, q, qd, vec_in, external, use_external, 0.0)
         if bad >= 0:
             return 0, 1, bad
         if mode == FORWARD:
@@ -82,6 +83,10 @@ def articulation_kernel(ints, reals, q, qd, vec_in, external, use_external, work
         elif mode == INVERSE:
             rnea(m.link_ints, m.world, m.dof_params, w.link_work, w.dof_motion, q, qd, vec_in, external, use_external,
                  vec_out)  # fmt: skip
+            fill(w.dof_work[RHS], 0.0)  # less the actuators' and tendons' forces, which drive beside τ
+            drive = applied_forces(m, w, q, qd, w.dof_work[RHS])
+            for k in range(vec_out.shape[0]):
+                vec_out[k] -= drive[k]
         elif mode == MASS_MATRIX:
             fill_matrix(w.mass_matrix, 0.0)  # the CRBA writes only the entries of pairs on one path to the base
             crba(m.link_ints, m.dof_ints, m.dof_params, w.link_work, w.dof_motion, w.mass_matrix)
@@ -120,7 +125,7 @@ def batch_kernel(ints, reals, q, qd, tau, work, external, h, method, steps, firs
     buffer that it did not write first, so one buffer serves copy after copy (and stays in the cache).
     """
     m = model_views(ints, reals)
-    w = work_views(work, ints[0], ints[1], ints[2], ints[3])
+    w = work_views(work, ints[0], ints[1], ints[2], ints[3], ints[4])
     failed = 0
     for c in range(first, last):
         q_c, qd_c, tau_c = q[c], qd[c], tau[c]

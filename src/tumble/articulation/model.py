@@ -46,18 +46,36 @@ POINT_A, POINT_B = 0, 3
 POS, QUAT, VEL, VEL_PRODUCT, ACC, FORCE, INERTIA_WORLD, COMPOSITE = 0, 3, 7, 13, 19, 25, 31, 41
 ART_INERTIA, ART_BIAS, ART_STORED = 51, 72, 78
 LINK_WORK_WIDTH = 79
-# dof_params columns: the joint's passive terms on each degree of freedom, and its actuators' drive
-# ``DRIVE + DRIVE_Q q + DRIVE_QD q̇`` (the controls folded into DRIVE)
-DAMPING, ARMATURE, STIFFNESS, SPRINGREF, DRIVE, DRIVE_Q, DRIVE_QD = 0, 1, 2, 3, 4, 5, 6
-DOF_PARAM_WIDTH = 7
+# dof_params columns: the joint's passive terms on each degree of freedom
+DAMPING, ARMATURE, STIFFNESS, SPRINGREF = 0, 1, 2, 3
+DOF_PARAM_WIDTH = 4
+# scalar_reals columns: a scalar is a joint's coordinate or a fixed tendon, ``L = scalar_q · q`` and
+# ``L̇ = scalar_v · q̇`` (constraints.py). Its limits (LIMITED 1.0 or 0.0, LOWER, UPPER, MARGIN and MuJoCo's solref (2)
+# and solimp (5) of the limit), its dry friction (FRICTIONLOSS and its solref, solimp), ``INVWEIGHT`` (MuJoCo's
+# ``invweight0``: ``J H⁻¹ Jᵀ`` at the initial coordinates), and a tendon's spring and damper (a joint's own are in
+# dof_params)
+LIMITED, LOWER, UPPER, MARGIN, LIMIT_SOLREF, LIMIT_SOLIMP = 0, 1, 2, 3, 4, 6
+FRICTIONLOSS, FRICTION_SOLREF, FRICTION_SOLIMP, INVWEIGHT = 11, 12, 14, 19
+TENDON_STIFFNESS, TENDON_SPRINGLENGTH, TENDON_DAMPING = 20, 21, 22
+SCALAR_WIDTH = 23
+# act_reals columns: an actuator on scalar ``act_ints[a, 0]`` pulls along ``l = GEAR · L`` with the force
+# ``FORCE0 + BIAS_LENGTH l + BIAS_SPEED l̇`` (FORCE0 = gain · clipped control + bias₀), clipped to
+# ``[FORCE_LOW, FORCE_HIGH]``
+GEAR, FORCE0, BIAS_LENGTH, BIAS_SPEED, FORCE_LOW, FORCE_HIGH = 0, 1, 2, 3, 4, 5
+ACT_WIDTH = 6
 # dof_work rows
-BIAS, RHS, QDD, DIAG, QD_START, QD_STAGE, QDD_SUM, QD_SUM, CHART = 0, 1, 2, 3, 4, 5, 6, 7, 8
-DOF_WORK_ROWS = 9
+BIAS, RHS, QDD, DIAG, QD_START, QD_STAGE, QDD_SUM, QD_SUM, CHART, APPLIED = 0, 1, 2, 3, 4, 5, 6, 7, 8, 9
+DOF_WORK_ROWS = 10
 # loop_work rows
 LOOP_RHS, LOOP_LAMBDA, LOOP_ACTIVE, LOOP_ERROR = 0, 1, 2, 3
 LOOP_WORK_ROWS = 4
+# efc_work rows, one column per constraint row (at most three a scalar: its friction and its two limits):
+# the scalar, the row's sign (its Jacobian is ``sign · scalar_v``), MuJoCo's reference acceleration and
+# regulariser R, the force's bounds, the force, and ``J q̈_smooth - aref``
+EFC_SCALAR, EFC_SIGN, EFC_AREF, EFC_R, EFC_LOW, EFC_HIGH, EFC_FORCE, EFC_OFFSET = 0, 1, 2, 3, 4, 5, 6, 7
+EFC_WORK_ROWS = 8
 
-_HEADER = 4  # ints[0:4] = link_count, q_count, v_count, loop_count
+_HEADER = 6  # ints[0:6] = link_count, q_count, v_count, loop_count, scalar_count, actuator_count
 
 
 class Model(NamedTuple):
@@ -71,13 +89,15 @@ class Model(NamedTuple):
             (4): the link frame in the parent frame at zero displacement; ``MASS`` [kg]; ``COM`` (3) [m] and
             ``INERTIA`` (9) [kg m²] about it, link frame.
         dof_ints: (nv, 2) int64: ``DOF_PARENT`` (-1: none) and ``DOF_LINK``.
-        dof_params: (nv, 7): ``DAMPING`` [N m s/rad or N s/m], ``ARMATURE`` (a rotor's inertia added to the
+        dof_params: (nv, 4): ``DAMPING`` [N m s/rad or N s/m], ``ARMATURE`` (a rotor's inertia added to the
             degree of freedom's own, [kg m²] or [kg]), ``STIFFNESS`` [N m/rad or N/m] and ``SPRINGREF`` (the
-            spring's rest coordinate) of the joint: the force ``-damping q̇ - stiffness (q - springref)``; and
-            the drive of its actuators at their present controls, ``DRIVE + DRIVE_Q q + DRIVE_QD q̇``.
+            spring's rest coordinate) of the joint: the force ``-damping q̇ - stiffness (q - springref)``.
         world: (10,): ``GRAVITY`` (3) [m/s²], ``BASE_POS`` (3) [m], ``BASE_QUAT`` (4).
         loop_ints: (L, 2) int64: ``LINK_A``, ``LINK_B`` (-1: the world).
         loop_reals: (L, 6): ``POINT_A``, ``POINT_B`` [m], in the frames of link a and link b (or the world).
+        scalar_q: (S, nq), scalar_v: (S, nv): each scalar's coefficients (a joint's or a fixed tendon's length).
+        scalar_reals: (S, 23): its limits, dry friction and tendon spring (the columns above).
+        act_ints: (A, 1) int64: each actuator's scalar; act_reals: (A, 6): its force law (the columns above).
     """
 
     link_ints: np.ndarray
@@ -87,6 +107,11 @@ class Model(NamedTuple):
     world: np.ndarray
     loop_ints: np.ndarray
     loop_reals: np.ndarray
+    scalar_q: np.ndarray
+    scalar_v: np.ndarray
+    scalar_reals: np.ndarray
+    act_ints: np.ndarray
+    act_reals: np.ndarray
 
 
 class Work(NamedTuple):
@@ -104,13 +129,16 @@ class Work(NamedTuple):
         dof_motion: (nv, 6): the motion subspace column of each degree of freedom.
         dof_u: (nv, 6): the ABA's ``U = I^A S`` column of each degree of freedom.
         mass_matrix: (nv, nv): the joint-space inertia matrix, or its LTDL factor after factorisation.
-        dof_work: (9, nv): rows ``BIAS``, ``RHS``, ``QDD``, ``DIAG`` (``H``'s diagonal, or the ABA's pivots) and
-            the integrator's ``QD_START``, ``QD_STAGE``, ``QDD_SUM``, ``QD_SUM``, ``CHART``.
+        dof_work: (10, nv): rows ``BIAS``, ``RHS``, ``QDD``, ``DIAG`` (``H``'s diagonal, or the ABA's pivots),
+            the integrator's ``QD_START``, ``QD_STAGE``, ``QDD_SUM``, ``QD_SUM``, ``CHART``, and ``APPLIED`` (the
+            joint forces with the actuators' and tendons').
         q_start, q_stage: (nq,): the integrator's coordinates at the start of a step and at an RK4 stage.
         loop_jac, loop_minv_jt: (3L, nv): the closure Jacobian ``J`` and ``(H⁻¹ Jᵀ)ᵀ``.
         loop_matrix: (3L, 3L): ``J H⁻¹ Jᵀ`` or its factor.
         loop_work: (4, 3L): rows ``LOOP_RHS`` (γ), ``LOOP_LAMBDA``, ``LOOP_ACTIVE``, ``LOOP_ERROR`` (φ).
         energy: (2,) [J]: kinetic and potential.
+        efc_minv_jt: (3S, nv): ``H⁻¹ Jᵀ`` of each active constraint row; efc_matrix: (3S, 3S): ``J H⁻¹ Jᵀ``;
+        efc_work: (8, 3S): the rows' data (the ``EFC_*`` rows above).
     """
 
     link_work: np.ndarray
@@ -125,20 +153,25 @@ class Work(NamedTuple):
     loop_matrix: np.ndarray
     loop_work: np.ndarray
     energy: np.ndarray
+    efc_minv_jt: np.ndarray
+    efc_matrix: np.ndarray
+    efc_work: np.ndarray
 
 
-def _int_size(n: int, nv: int, loops: int) -> int:
-    return _HEADER + LINK_INT_WIDTH * n + 2 * nv + 2 * loops
+def _int_size(n: int, nv: int, loops: int, actuators: int) -> int:
+    return _HEADER + LINK_INT_WIDTH * n + 2 * nv + 2 * loops + actuators
 
 
-def _real_size(n: int, nv: int, loops: int) -> int:
-    return WORLD_WIDTH + LINK_REAL_WIDTH * n + DOF_PARAM_WIDTH * nv + 6 * loops
+def _real_size(n: int, nq: int, nv: int, loops: int, scalars: int, actuators: int) -> int:
+    return (WORLD_WIDTH + LINK_REAL_WIDTH * n + DOF_PARAM_WIDTH * nv + 6 * loops + scalars * (nq + nv + SCALAR_WIDTH)
+            + ACT_WIDTH * actuators)  # fmt: skip
 
 
-def work_size(n: int, nq: int, nv: int, loops: int) -> int:
+def work_size(n: int, nq: int, nv: int, loops: int, scalars: int) -> int:
     """The length of the work buffer that :func:`work_views` carves."""
-    nc = 3 * loops
-    return LINK_WORK_WIDTH * n + 12 * nv + nv * nv + DOF_WORK_ROWS * nv + 2 * nq + 2 * nc * nv + nc * nc + 4 * nc + 2
+    nc, nr = 3 * loops, 3 * scalars
+    return (LINK_WORK_WIDTH * n + 12 * nv + nv * nv + DOF_WORK_ROWS * nv + 2 * nq + 2 * nc * nv + nc * nc + 4 * nc + 2
+            + nr * nv + nr * nr + EFC_WORK_ROWS * nr)  # fmt: skip
 
 
 @inline
@@ -154,24 +187,35 @@ def _rows(buffer, start, count, width):
 @inline
 def model_views(ints, reals):
     """Carve ``ints`` and ``reals`` into a :class:`Model` of views (no copies)."""
-    n, nv, nl = ints[0], ints[2], ints[3]
+    n, nq, nv, nl, ns, na = ints[0], ints[1], ints[2], ints[3], ints[4], ints[5]
     i = _HEADER
     link_ints = _rows(ints, i, n, LINK_INT_WIDTH)
     i += LINK_INT_WIDTH * n
     dof_ints = _rows(ints, i, nv, 2)
     loop_ints = _rows(ints, i + 2 * nv, nl, 2)
+    act_ints = _rows(ints, i + 2 * nv + 2 * nl, na, 1)
     r = WORLD_WIDTH
     link_reals = _rows(reals, r, n, LINK_REAL_WIDTH)
     r += LINK_REAL_WIDTH * n
     dof_params = _rows(reals, r, nv, DOF_PARAM_WIDTH)
-    loop_reals = _rows(reals, r + DOF_PARAM_WIDTH * nv, nl, 6)
-    return Model(link_ints, link_reals, dof_ints, dof_params, reals[0:WORLD_WIDTH], loop_ints, loop_reals)
+    r += DOF_PARAM_WIDTH * nv
+    loop_reals = _rows(reals, r, nl, 6)
+    r += 6 * nl
+    scalar_q = _rows(reals, r, ns, nq)
+    r += ns * nq
+    scalar_v = _rows(reals, r, ns, nv)
+    r += ns * nv
+    scalar_reals = _rows(reals, r, ns, SCALAR_WIDTH)
+    r += ns * SCALAR_WIDTH
+    act_reals = _rows(reals, r, na, ACT_WIDTH)
+    return Model(link_ints, link_reals, dof_ints, dof_params, reals[0:WORLD_WIDTH], loop_ints, loop_reals, scalar_q,
+                 scalar_v, scalar_reals, act_ints, act_reals)  # fmt: skip
 
 
 @inline
-def work_views(work, n, nq, nv, nl):
+def work_views(work, n, nq, nv, nl, ns):
     """Carve ``work`` into a :class:`Work` of views."""
-    nc = 3 * nl
+    nc, nr = 3 * nl, 3 * ns
     link_work = _rows(work, 0, n, LINK_WORK_WIDTH)
     w = LINK_WORK_WIDTH * n
     dof_motion = _rows(work, w, nv, 6)
@@ -190,8 +234,15 @@ def work_views(work, n, nq, nv, nl):
     w += nc * nc
     loop_work = _rows(work, w, LOOP_WORK_ROWS, nc)
     w += LOOP_WORK_ROWS * nc
+    energy = work[w : w + 2]
+    w += 2
+    efc_minv_jt = _rows(work, w, nr, nv)
+    w += nr * nv
+    efc_matrix = _rows(work, w, nr, nr)
+    w += nr * nr
+    efc_work = _rows(work, w, EFC_WORK_ROWS, nr)
     return Work(link_work, dof_motion, dof_u, mass_matrix, dof_work, q_start, q_stage, loop_jac, loop_minv_jt,
-                loop_matrix, loop_work, work[w : w + 2])  # fmt: skip
+                loop_matrix, loop_work, energy, efc_minv_jt, efc_matrix, efc_work)  # fmt: skip
 
 
 def python_function(compiled):
@@ -199,26 +250,28 @@ def python_function(compiled):
     return getattr(compiled, "py_func", compiled)
 
 
-def counts(ints: np.ndarray) -> tuple[int, int, int, int]:
-    """``(link_count, q_count, v_count, loop_count)`` from the header of ``ints``."""
-    return int(ints[0]), int(ints[1]), int(ints[2]), int(ints[3])
+def counts(ints: np.ndarray) -> tuple[int, int, int, int, int]:
+    """``(link_count, q_count, v_count, loop_count, scalar_count)`` from the header of ``ints``: the arguments of
+    :func:`work_size` and :func:`work_views`."""
+    return int(ints[0]), int(ints[1]), int(ints[2]), int(ints[3]), int(ints[4])
 
 
-def pack_model(links, loops, gravity, base_pos, base_quat, drives=None) -> tuple[np.ndarray, np.ndarray]:
+def pack_model(links, loops, gravity, base_pos, base_quat, scalars=(), actuators=()) -> tuple[np.ndarray, np.ndarray]:
     """Build ``(ints, reals)`` from link and loop descriptions.
 
     Args:
         links: sequence of :class:`~tumble.articulation.articulation.Link` (parents before children).
         loops: sequence of :class:`~tumble.articulation.loops.LoopClosure`.
         gravity, base_pos: (3,); base_quat: (4,), unit.
-        drives: (nv, 3) the actuators' ``DRIVE``, ``DRIVE_Q``, ``DRIVE_QD`` columns (default none).
+        scalars: sequence of ``(q coefficients (nq,), v coefficients (nv,), the SCALAR_WIDTH columns)``.
+        actuators: sequence of ``(scalar, the ACT_WIDTH columns)``.
     """
-    n, nl = len(links), len(loops)
+    n, nl, ns, na = len(links), len(loops), len(scalars), len(actuators)
     nq = sum(link.joint.nq for link in links)
     nv = sum(link.joint.nv for link in links)
-    ints = np.zeros(_int_size(n, nv, nl), dtype=np.int64)
-    reals = np.zeros(_real_size(n, nv, nl), dtype=np.float64)
-    ints[:_HEADER] = (n, nq, nv, nl)
+    ints = np.zeros(_int_size(n, nv, nl, na), dtype=np.int64)
+    reals = np.zeros(_real_size(n, nq, nv, nl, ns, na), dtype=np.float64)
+    ints[:_HEADER] = (n, nq, nv, nl, ns, na)
     m = python_function(model_views)(ints, reals)
     m.world[GRAVITY : GRAVITY + 3], m.world[BASE_POS : BASE_POS + 3] = gravity, base_pos
     m.world[BASE_QUAT : BASE_QUAT + 4] = base_quat
@@ -227,7 +280,7 @@ def pack_model(links, loops, gravity, base_pos, base_quat, drives=None) -> tuple
         above = -1 if link.parent is None else m.link_ints[link.parent, DOF_TIP]
         for k in range(link.v_slice.start, link.v_slice.stop):
             m.dof_ints[k] = (above, i)
-            m.dof_params[k, :DRIVE] = (link.damping, link.armature, link.stiffness, link.springref)
+            m.dof_params[k] = (link.damping, link.armature, link.stiffness, link.springref)
             above = k
         m.link_ints[i] = (-1 if link.parent is None else link.parent, int(joint.type), link.q_slice.start,
                           link.v_slice.start, above)  # fmt: skip
@@ -239,8 +292,10 @@ def pack_model(links, loops, gravity, base_pos, base_quat, drives=None) -> tuple
             row[MASS] = link.mass_properties.mass
             row[COM : COM + 3] = link.mass_properties.com
             row[INERTIA : INERTIA + 9] = link.mass_properties.inertia.ravel()
-    if drives is not None:
-        m.dof_params[:, DRIVE:] = drives
+    for s, (q_coefficients, v_coefficients, columns) in enumerate(scalars):
+        m.scalar_q[s], m.scalar_v[s], m.scalar_reals[s] = q_coefficients, v_coefficients, columns
+    for a, (scalar, columns) in enumerate(actuators):
+        m.act_ints[a, 0], m.act_reals[a] = scalar, columns
     for k, loop in enumerate(loops):
         m.loop_ints[k] = (loop.link_a, -1 if loop.link_b is None else loop.link_b)
         m.loop_reals[k, POINT_A : POINT_A + 3] = loop.point_a

@@ -91,6 +91,13 @@ def from_articulation(articulation, gravity=None, *, parameters=None) -> System:
         if getattr(link, "armature", 0.0) != 0.0 or getattr(link, "stiffness", 0.0) != 0.0:
             raise ValueError(f"link {_label(link)} has joint armature or stiffness, which the symbolic derivation "
                              "does not model yet")  # fmt: skip
+    for link in links.values():
+        if getattr(link, "limits", None) is not None or getattr(link, "frictionloss", 0.0) != 0.0:
+            raise ValueError(f"link {_label(link)} has joint limits or frictionloss, constraints that the symbolic "
+                             "derivation does not model")  # fmt: skip
+    if getattr(articulation, "tendons", ()):
+        raise ValueError(f"articulation has {len(articulation.tendons)} tendons, which the symbolic derivation does "
+                         "not model yet")  # fmt: skip
     if getattr(articulation, "actuators", ()):
         raise ValueError(f"articulation has {len(articulation.actuators)} actuators, which the symbolic derivation "
                          "does not model yet: give their forces as generalised forces instead")  # fmt: skip

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..articulation import Articulation, Ball, Fixed, Free, Prismatic, Revolute
+from ..articulation import Articulation, Ball, Fixed, Free, Prismatic, Revolute, SoftConstraint
 from ..rotation import quat_from_axis_angle, quat_multiply, quat_rotate
 from .description import JointDescription, ModelDescription
 
@@ -63,7 +63,10 @@ def to_articulation(model: ModelDescription) -> Articulation:
             parent = art.add_link(link_joint, parent=parent, position=position, orientation=orientation,
                                   mass_properties=properties if last else None, damping=joint.damping,
                                   name=name, armature=joint.armature, stiffness=_spring(joint),
-                                  springref=joint.springref)  # fmt: skip
+                                  springref=joint.springref, frictionloss=joint.frictionloss,
+                                  limits=joint.range if joint.type in ("hinge", "slide") else None,
+                                  margin=joint.margin, limit_softness=_softness(joint.limit_softness),
+                                  friction_softness=_softness(joint.friction_softness))  # fmt: skip
             if joint.type in ("hinge", "slide") and joint.ref != 0.0:
                 initial.append((parent, joint.ref))
             if joint.name is not None:
@@ -71,10 +74,25 @@ def to_articulation(model: ModelDescription) -> Articulation:
         last_link[index] = (parent, joints[-1].pos)
     for link, ref in initial:
         art.set_joint(link, q=ref)
+    tendons = {}
+    for tendon in model.tendons:
+        tendons[tendon.name] = art.add_tendon(
+            [joint_links[joint] for joint in tendon.joints], tendon.coefficients, limits=tendon.range,
+            margin=tendon.margin, frictionloss=tendon.frictionloss, limit_softness=_softness(tendon.limit_softness),
+            friction_softness=_softness(tendon.friction_softness), stiffness=tendon.stiffness, damping=tendon.damping,
+            springlength=tendon.springlength, name=tendon.name,
+        )  # fmt: skip
     for actuator in model.actuators:
-        art.add_actuator(joint_links[actuator.joint], gear=actuator.gear, gain=actuator.gain, bias=actuator.bias,
-                         ctrl_range=actuator.ctrl_range, name=actuator.name)  # fmt: skip
+        link = None if actuator.joint is None else joint_links[actuator.joint]
+        art.add_actuator(link, tendon=None if actuator.tendon is None else tendons[actuator.tendon],
+                         gear=actuator.gear, gain=actuator.gain, bias=actuator.bias, ctrl_range=actuator.ctrl_range,
+                         force_range=actuator.force_range, name=actuator.name)  # fmt: skip
     return art
+
+
+def _softness(settings) -> SoftConstraint | None:
+    """MJCF's ``(solref, solimp)`` as a :class:`SoftConstraint` (``None``: MuJoCo's defaults)."""
+    return None if settings is None else SoftConstraint(*settings)
 
 
 def _spring(joint: JointDescription) -> float:

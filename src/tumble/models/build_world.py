@@ -192,7 +192,15 @@ def _check(model: ModelDescription) -> set[str]:
     if notes:
         warnings.warn(f"{model.source}: a tumble World's joints do not simulate joint {', '.join(notes)} (yet; a "
                       "body's one hinge or slide keeps its damping); ignored", MJCFWarning, stacklevel=3)  # fmt: skip
-    return undriven
+    if model.tendons:
+        warnings.warn(f"{model.source}: a tumble World does not simulate tendons (yet; tumble.articulation.from_mjcf "
+                      "does), nor the actuators that pull them; ignored", MJCFWarning, stacklevel=3)  # fmt: skip
+    forced = [a.name or a.joint for a in model.actuators if a.force_range is not None]
+    if forced:
+        warnings.warn(f"{model.source}: a tumble World does not clip the forces of actuators "
+                      f"{', '.join(map(repr, forced))} to their forcerange (yet); ignored", MJCFWarning,
+                      stacklevel=3)  # fmt: skip
+    return undriven | {None}
 
 
 def _moving_body(model: ModelDescription, index: int, welded: list[int], poses, filters):

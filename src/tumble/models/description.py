@@ -15,7 +15,7 @@ import numpy as np
 from ..mass import MassProperties
 
 __all__ = ["ActuatorDescription", "BodyDescription", "GeomDescription", "JointDescription", "MeshDescription",
-           "ModelDescription"]  # fmt: skip
+           "ModelDescription", "TendonDescription"]  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -36,6 +36,29 @@ class JointDescription:
     line: int
     # MJCF's (time constant [s], damping ratio) that sized ``stiffness`` and ``damping`` from the joint's mass
     springdamper: tuple[float, float] | None = None
+    # the distance from a limit at which it acts, and MuJoCo's (solref, solimp) of the limits and dry friction
+    margin: float = 0.0
+    limit_softness: tuple[tuple[float, ...], tuple[float, ...]] | None = None
+    friction_softness: tuple[tuple[float, ...], tuple[float, ...]] | None = None
+
+
+@dataclass(frozen=True)
+class TendonDescription:
+    """A fixed tendon: the length ``Σ coefficients · q`` over named hinges and slides, with MuJoCo's limit, dry
+    friction, spring and damper (``springlength`` None: the length at the model's pose)."""
+
+    name: str | None
+    joints: tuple[str, ...]
+    coefficients: tuple[float, ...]
+    range: tuple[float, float] | None
+    margin: float
+    frictionloss: float
+    stiffness: float
+    damping: float
+    springlength: float | None
+    limit_softness: tuple[tuple[float, ...], tuple[float, ...]]
+    friction_softness: tuple[tuple[float, ...], tuple[float, ...]]
+    line: int
 
 
 @dataclass(frozen=True)
@@ -84,17 +107,20 @@ class BodyDescription:
 
 @dataclass(frozen=True)
 class ActuatorDescription:
-    """An actuator on a hinge or slide joint: the force ``gain · ctrl + bias · (1, l, l̇)`` along its length
-    ``l = gear · q``, the control clipped to ``ctrl_range`` (see ``tumble.articulation.actuators``)."""
+    """An actuator on a hinge or slide joint (or a fixed tendon): the force ``gain · ctrl + bias · (1, l, l̇)`` along
+    its length ``l = gear · q``, the control clipped to ``ctrl_range`` and the force to ``force_range`` (see
+    ``tumble.articulation.actuators``)."""
 
     name: str | None
     kind: str  # the element it was written as: "motor", "position", "velocity" or "general"
-    joint: str
+    joint: str | None
     gear: float
     gain: float
     bias: np.ndarray  # (3,)
     ctrl_range: tuple[float, float] | None
     line: int
+    force_range: tuple[float, float] | None = None
+    tendon: str | None = None
 
 
 @dataclass(frozen=True)
@@ -110,6 +136,7 @@ class ModelDescription:
     integrator: str = "Euler"
     meshes: dict[str, MeshDescription] = field(default_factory=dict)
     actuators: tuple[ActuatorDescription, ...] = ()  # those tumble simulates, in the file's order
+    tendons: tuple[TendonDescription, ...] = ()
 
     def body_index(self, name: str) -> int:
         for index, body in enumerate(self.bodies):

@@ -1,9 +1,11 @@
-"""MJCF ``<actuator>``: motors, position and velocity servos and general actuators on hinge and slide joints.
+"""MJCF ``<actuator>``: motors, position and velocity servos and general actuators on hinges, slides and fixed
+tendons.
 
 MuJoCo's actuator pulls along its transmission's length ``l`` with ``gain · ctrl + bias₀ + bias₁ l + bias₂ l̇``;
 ``motor`` (gain 1), ``position`` (``kp``, ``kv``: gain ``kp``, bias ``(0, -kp, -kv)``) and ``velocity`` (``kv``:
 gain ``kv``, bias ``(0, 0, -kv)``) are shortcuts for it. tumble simulates those with a joint transmission (``joint=``
-a hinge or slide; ``l = gear · q``), a fixed gain, an affine bias or none, and no activation dynamics. Any other
+a hinge or slide; ``l = gear · q``) or a fixed tendon's (``tendon=``), a fixed gain, an affine bias or none, the
+force clipped to ``forcerange``, and no activation dynamics. Any other
 actuator is named in one warning and not loaded, so ``art.ctrl`` holds the loaded ones in the file's order. A
 default class's actuator settings, from whichever actuator element wrote them, apply to every kind, as in MuJoCo,
 where they are the class's one ``general`` default.
@@ -23,12 +25,12 @@ __all__ = ["ACTUATOR_TAGS", "describe_actuator"]
 
 ACTUATOR_TAGS = ("general", "motor", "position", "velocity", "intvelocity", "damper", "cylinder", "muscle",
                  "adhesion", "plugin")  # fmt: skip
-_KNOWN = {"name", "class", "group", "joint", "gear", "ctrlrange", "ctrllimited", "forcerange", "forcelimited",
+_KNOWN = {"name", "class", "group", "joint", "tendon", "gear", "ctrlrange", "ctrllimited", "forcerange", "forcelimited",
           "user", "lengthrange"}  # fmt: skip
 _OWN = {"motor": set(), "position": {"kp", "kv"}, "velocity": {"kv"},
         "general": {"gaintype", "biastype", "dyntype", "gainprm", "biasprm", "dynprm", "actlimited", "actrange",
                     "actdim", "actearly"}}  # fmt: skip
-_TRANSMISSIONS = ("tendon", "site", "body", "jointinparent", "cranksite", "slidersite")
+_TRANSMISSIONS = ("site", "body", "jointinparent", "cranksite", "slidersite")
 _UP_TO_TEN = tuple(range(1, 11))
 
 
@@ -70,10 +72,12 @@ def _limited(node: Node, a: dict[str, str], name: str, autolimits: bool) -> tupl
     return float(low), float(high)
 
 
-def describe_actuator(node: Node, a: dict[str, str], joint_types: dict[str, str], autolimits: bool,
+def describe_actuator(node: Node, a: dict[str, str], joint_types: dict[str, str], tendons: set[str],
+                      autolimits: bool,
                       note: Callable[[Node, str, str], None]) -> ActuatorDescription | None:  # fmt: skip
     """The actuator ``node`` (its attributes ``a`` resolved against the defaults), or None after a warning through
-    ``note`` when tumble does not simulate it. ``joint_types``: each named joint's type."""
+    ``note`` when tumble does not simulate it. ``joint_types``: each named joint's type; ``tendons``: the names of
+    the fixed tendons."""
     kind = node.tag
     if kind not in _OWN:
         note(node, "element", "this actuator is not simulated by tumble; not loaded")
@@ -82,13 +86,17 @@ def describe_actuator(node: Node, a: dict[str, str], joint_types: dict[str, str]
         if name not in _KNOWN and name not in _OWN[kind] and name not in _TRANSMISSIONS:
             note(node, name, "not supported by tumble; ignored")
     given = [name for name in _TRANSMISSIONS if name in a]
-    if given or "joint" not in a:
-        note(node, given[0] if given else "joint", "tumble drives joints only; this actuator is not loaded")
+    if given or ("joint" not in a and "tendon" not in a):
+        note(node, given[0] if given else "joint", "tumble drives joints and fixed tendons only; not loaded")
         return None
-    joint = a["joint"]
-    if joint not in joint_types:
+    joint, tendon = a.get("joint"), a.get("tendon")
+    if joint is not None and tendon is not None:
+        raise node.error("an actuator has one transmission: joint= or tendon=, not both")
+    if tendon is not None and tendon not in tendons:
+        raise node.error(f"tendon={tendon!r} names no fixed tendon")
+    if joint is not None and joint not in joint_types:
         raise node.error(f"joint={joint!r} names no joint")
-    if joint_types[joint] not in ("hinge", "slide"):
+    if joint is not None and joint_types[joint] not in ("hinge", "slide"):
         note(node, "joint", f"tumble drives hinges and slides, not a {joint_types[joint]}; not loaded")
         return None
     law = _law(node, kind, a)
@@ -96,7 +104,6 @@ def describe_actuator(node: Node, a: dict[str, str], joint_types: dict[str, str]
         note(node, "element", f"{law}; not loaded")
         return None
     gear = numbers(node, a, "gear", (1, 2, 3, 4, 5, 6), [1.0])
-    if _limited(node, a, "forcerange", autolimits) is not None:
-        note(node, "forcerange", "the actuator's force is not clipped by tumble (yet); ignored")
     return ActuatorDescription(a.get("name"), kind, joint, float(gear[0]), law[0], law[1],
-                               _limited(node, a, "ctrlrange", autolimits), node.line)  # fmt: skip
+                               _limited(node, a, "ctrlrange", autolimits), node.line,
+                               _limited(node, a, "forcerange", autolimits), tendon)  # fmt: skip

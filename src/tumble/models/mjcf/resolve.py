@@ -26,6 +26,7 @@ from ..description import (
     JointDescription,
     MeshDescription,
     ModelDescription,
+    TendonDescription,
 )
 from .actuators import ACTUATOR_TAGS, describe_actuator
 from .attributes import flag as _flag
@@ -43,6 +44,7 @@ from .inertia import (
 )
 from .mesh_inertia import MeshInertia, mesh_inertia
 from .meshes import MESH_ATTRIBUTES, MESH_COSMETIC, read_mesh
+from .tendons import describe_tendons, softness
 from .xml import Node
 
 __all__ = ["MJCFWarning", "describe"]
@@ -234,9 +236,8 @@ def _joint(reader: _Reader, node: Node, childclass: str, is_top: bool) -> JointD
         if kind != "ball" and low >= high:
             raise node.error(f"range={a.get('range')!r} must have its lower bound below the upper")
         bounds = (float(low), float(high))
-        reader.note(
-            node, "range", "joint limits are enforced in a World (tumble.load_mjcf), not by an Articulation (yet)"
-        )
+        if kind == "ball":
+            reader.note(node, "range", "a ball joint's limit (a cone) is not simulated by tumble's Articulation (yet)")
     joint = JointDescription(
         name=a.get("name"),
         type=kind,
@@ -251,13 +252,14 @@ def _joint(reader: _Reader, node: Node, childclass: str, is_top: bool) -> JointD
         frictionloss=_number(node, a, "frictionloss", 0.0, nonnegative=True),
         line=node.line,
         springdamper=_springdamper(reader, node, a, kind),
+        margin=_number(node, a, "margin", 0.0, nonnegative=True),
+        limit_softness=softness(node, a, "limit"),
+        friction_softness=softness(node, a, "friction"),
     )
     if np.any(stiffness[1:] != 0.0):
         reader.note(node, "stiffness", "only the linear spring (its first number) is simulated by tumble")
     if stiffness[0] != 0.0 and kind in ("ball", "free"):
         reader.note(node, "stiffness", f"a spring on a {kind} joint is not simulated by tumble; ignored")
-    if joint.frictionloss != 0.0:
-        reader.note(node, "frictionloss", "not simulated by tumble's Articulation (yet); ignored")
     if kind == "free" and "pos" in a and np.any(_numbers(node, a, "pos", 3)):
         reader.note(node, "pos", "ignored on a free joint: its coordinates are the body's pose")
     return joint
@@ -469,9 +471,32 @@ def _read_assets(reader: _Reader, node: Node, base: Path) -> None:
         reader.meshes[mesh.name] = (mesh, child)
 
 
-def _read_actuators(reader: _Reader, root: Node, bodies: list[BodyDescription]) -> tuple[ActuatorDescription, ...]:
-    """The actuators tumble simulates, from every ``<actuator>`` section, once the joints are known."""
-    joint_types = {j.name: j.type for body in bodies for j in body.joints if j.name is not None}
+def _joint_types(bodies: list[BodyDescription]) -> dict[str, str]:
+    return {j.name: j.type for body in bodies for j in body.joints if j.name is not None}
+
+
+def _tendon_resolved(reader: _Reader, node: Node) -> dict[str, str]:
+    """A tendon's attributes over its class's ``<tendon>`` defaults (MuJoCo's one default for every tendon kind)."""
+    name = node.attrib.get("class", "main")
+    if name not in reader.defaults:
+        raise node.error(f"class={name!r} names no default class")
+    return {**reader.defaults[name].get("tendon", {}), **node.attrib}
+
+
+def _read_tendons(reader: _Reader, root: Node, bodies: list[BodyDescription]) -> tuple[TendonDescription, ...]:
+    """The fixed tendons of every ``<tendon>`` section, once the joints are known."""
+    joint_types, found = _joint_types(bodies), []
+    for section in (child for child in root.children if child.tag == "tendon"):
+        found += describe_tendons(section, lambda node: _tendon_resolved(reader, node), joint_types,
+                                  reader.compiler.autolimits, reader.note)  # fmt: skip
+    return tuple(found)
+
+
+def _read_actuators(reader: _Reader, root: Node, bodies: list[BodyDescription],
+                    tendons: tuple[TendonDescription, ...]) -> tuple[ActuatorDescription, ...]:  # fmt: skip
+    """The actuators tumble simulates, from every ``<actuator>`` section, once the joints and tendons are known."""
+    joint_types = _joint_types(bodies)
+    tendon_names = {tendon.name for tendon in tendons if tendon.name is not None}
     found = []
     for node in (child for section in root.children if section.tag == "actuator" for child in section.children):
         name = node.attrib.get("class", "main")
@@ -479,7 +504,7 @@ def _read_actuators(reader: _Reader, root: Node, bodies: list[BodyDescription]) 
             raise node.error(f"class={name!r} names no default class")
         defaults = reader.defaults[name]
         a = {key: value for tag in ACTUATOR_TAGS for key, value in defaults.get(tag, {}).items()} | node.attrib
-        actuator = describe_actuator(node, a, joint_types, reader.compiler.autolimits, reader.note)
+        actuator = describe_actuator(node, a, joint_types, tendon_names, reader.compiler.autolimits, reader.note)
         found += [actuator] if actuator is not None else []
     return tuple(found)
 
@@ -533,14 +558,15 @@ def describe(root: Node, base: Path) -> ModelDescription:
                     world_geoms.append(_geom(reader, child, "main")[0])
                 elif child.tag not in _SILENT:
                     reader.note(child, "element", "not supported by tumble; ignored")
-        elif node.tag not in _SILENT and node.tag not in ("compiler", "default", "asset", "actuator"):
+        elif node.tag not in _SILENT and node.tag not in ("compiler", "default", "asset", "actuator", "tendon"):
             reader.note(node, "element", "not loaded by tumble (yet); ignored")
-    actuators = _read_actuators(reader, root, bodies)
+    tendons = _read_tendons(reader, root, bodies)
+    actuators = _read_actuators(reader, root, bodies, tendons)
     if reader.compiler.settotalmass > 0:
         bodies = _scaled_to_total(bodies, reader.compiler.settotalmass)
     reader.warn_all(root.file)
     return ModelDescription(
         name=root.attrib.get("model", "MuJoCo Model"), source=root.file, bodies=tuple(bodies),
         world_geoms=tuple(world_geoms), gravity=gravity, timestep=timestep, integrator=integrator,
-        meshes={name: mesh for name, (mesh, _) in reader.meshes.items()}, actuators=actuators,
+        meshes={name: mesh for name, (mesh, _) in reader.meshes.items()}, actuators=actuators, tendons=tendons,
     )  # fmt: skip

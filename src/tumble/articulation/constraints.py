@@ -1,0 +1,212 @@
+"""Joint and tendon physics beyond the tree: actuators, tendon springs, and MuJoCo's soft limits and dry friction.
+
+A *scalar* is a linear function of the coordinates: a hinge's or slide's coordinate, or a fixed tendon's length
+``L = Σ cᵢ qᵢ`` (MuJoCo's ``<fixed>`` tendon), with the velocity ``L̇ = J q̇`` (``model.scalar_q``, ``scalar_v``).
+Actuators pull along scalars, tendons carry springs and dampers, and limits and dry friction hold them.
+
+Actuators and springs are forces (:func:`applied_forces`). Limits and friction are constraints, solved as MuJoCo
+solves them (MuJoCo documentation, *Computation*: "Soft constraints" and "Solver parameters"). Each active row
+``i`` (a limit whose distance ``r`` is below its margin, or a scalar with frictionloss) has the Jacobian ``Jᵢ``, the
+impedance ``d(r)`` of its ``solimp``, the stiffness and damping ``k = 1/(d_max² τ² ζ²)``, ``b = 2/(d_max τ)`` of its
+``solref = (τ, ζ)`` (or ``k = -solref₀/d_max²``, ``b = -solref₁/d_max`` when negative), the reference acceleration
+``aref = -b J q̇ - k d (r - margin)`` (``k = 0`` for friction) and the regulariser ``R = (1 - d)/d · invweight0``.
+The constraint forces solve MuJoCo's dual problem
+
+    min_f  ½ fᵀ (A + R) f + fᵀ (J q̈₀ - aref),    A = J H⁻¹ Jᵀ,   f ≥ 0 (limits),  |f| ≤ frictionloss (friction),
+
+and ``q̈ = q̈₀ + H⁻¹ Jᵀ f``, ``q̈₀`` the acceleration without them. ``A + R`` is positive definite, so the solution is
+unique and projected Gauss–Seidel reaches it to rounding (the same solution MuJoCo's Newton, CG and PGS solvers
+converge to). ``τ`` is at least twice the step, as MuJoCo keeps it (``mjDSBL_REFSAFE`` off).
+"""
+
+from __future__ import annotations
+
+import math
+
+from .._jit import inline
+from .dynamics import ltdl_solve
+from .model import (
+    APPLIED,
+    BIAS_LENGTH,
+    BIAS_SPEED,
+    EFC_AREF,
+    EFC_FORCE,
+    EFC_HIGH,
+    EFC_LOW,
+    EFC_OFFSET,
+    EFC_R,
+    EFC_SCALAR,
+    EFC_SIGN,
+    FORCE0,
+    FORCE_HIGH,
+    FORCE_LOW,
+    FRICTION_SOLIMP,
+    FRICTION_SOLREF,
+    FRICTIONLOSS,
+    GEAR,
+    INVWEIGHT,
+    LIMIT_SOLIMP,
+    LIMIT_SOLREF,
+    LIMITED,
+    LOWER,
+    MARGIN,
+    TENDON_DAMPING,
+    TENDON_SPRINGLENGTH,
+    TENDON_STIFFNESS,
+    UPPER,
+)
+
+__all__ = ["applied_forces", "constrained", "impedance", "scalar_value", "solve_constraints"]
+
+# MuJoCo's mjMINVAL: the smallest regulariser
+_MIN_VALUE = 1e-15
+# projected Gauss-Seidel stops when no force moves by more than this fraction of the largest (or after the cap)
+_TOLERANCE = 1e-13
+_MAX_SWEEPS = 10000
+
+
+@inline
+def scalar_value(coefficients, s, x):
+    """``Σ_j coefficients[s, j] x[j]``: a scalar's length (``scalar_q`` and ``q``) or rate (``scalar_v``, ``q̇``)."""
+    total = 0.0
+    for j in range(x.shape[0]):
+        total += coefficients[s, j] * x[j]
+    return total
+
+
+@inline
+def constrained(m):
+    """Whether any scalar has a limit or dry friction (the model then solves constraints at every evaluation)."""
+    for s in range(m.scalar_reals.shape[0]):
+        if m.scalar_reals[s, LIMITED] != 0.0 or m.scalar_reals[s, FRICTIONLOSS] > 0.0:
+            return True
+    return False
+
+
+@inline
+def applied_forces(m, w, q, qd, tau):
+    """The joint forces with the actuators' and the tendons' springs and dampers added: ``tau`` itself when the
+    model has neither, else ``w.dof_work[APPLIED]``."""
+    scalar_reals, act_reals = m.scalar_reals, m.act_reals
+    if m.act_ints.shape[0] == 0 and scalar_reals.shape[0] == 0:
+        return tau
+    out = w.dof_work[APPLIED]
+    for k in range(tau.shape[0]):
+        out[k] = tau[k]
+    for s in range(scalar_reals.shape[0]):
+        stiffness, damping = scalar_reals[s, TENDON_STIFFNESS], scalar_reals[s, TENDON_DAMPING]
+        if stiffness == 0.0 and damping == 0.0:
+            continue
+        force = -damping * scalar_value(m.scalar_v, s, qd)
+        if stiffness != 0.0:
+            force -= stiffness * (scalar_value(m.scalar_q, s, q) - scalar_reals[s, TENDON_SPRINGLENGTH])
+        for k in range(out.shape[0]):
+            out[k] += force * m.scalar_v[s, k]
+    for a in range(act_reals.shape[0]):
+        s, gear = m.act_ints[a, 0], act_reals[a, GEAR]
+        length, speed = gear * scalar_value(m.scalar_q, s, q), gear * scalar_value(m.scalar_v, s, qd)
+        force = act_reals[a, FORCE0] + act_reals[a, BIAS_LENGTH] * length + act_reals[a, BIAS_SPEED] * speed
+        force = min(max(force, act_reals[a, FORCE_LOW]), act_reals[a, FORCE_HIGH])
+        for k in range(out.shape[0]):
+            out[k] += gear * force * m.scalar_v[s, k]
+    return out
+
+
+@inline
+def impedance(row, c, distance):
+    """MuJoCo's impedance ``d`` of the solimp ``row[c:c + 5] = (d_min, d_max, width, midpoint, power)`` at
+    ``distance`` (the violation less the margin): ``d_min`` at 0 rising to ``d_max`` at ``width`` along two
+    power curves that meet at ``midpoint`` (MuJoCo documentation, *Modeling*: "Solver parameters")."""
+    low, high, width, middle, power = row[c], row[c + 1], row[c + 2], row[c + 3], row[c + 4]
+    if low == high or width <= _MIN_VALUE:
+        return 0.5 * (low + high)
+    x = abs(distance) / width
+    if x >= 1.0:
+        return high
+    if x <= 0.0:
+        return low
+    if power == 1.0:
+        y = x
+    elif x <= middle:
+        y = x**power / middle ** (power - 1.0)
+    else:
+        y = 1.0 - (1.0 - x) ** power / (1.0 - middle) ** (power - 1.0)
+    return low + y * (high - low)
+
+
+@inline
+def _add_row(m, w, count, s, sign, distance, margin, ref_column, imp_column, low, high, qd, h):
+    """Append constraint row ``count`` of scalar ``s`` (its Jacobian ``sign · scalar_v[s]``) to ``w.efc_work``: a
+    limit (``high`` infinite) or dry friction (``low = -high``, which has no position term)."""
+    row = m.scalar_reals[s]
+    imp = impedance(row, imp_column, distance - margin)
+    time_constant, damping_ratio = row[ref_column], row[ref_column + 1]
+    d_max = row[imp_column + 1]
+    if time_constant > 0.0:
+        time_constant = max(time_constant, 2.0 * h)
+        stiffness = 1.0 / (d_max * d_max * time_constant * time_constant * damping_ratio * damping_ratio)
+        damping = 2.0 / (d_max * time_constant)
+    else:
+        stiffness, damping = -time_constant / (d_max * d_max), -damping_ratio / d_max
+    if high != math.inf:
+        stiffness = 0.0
+    e = w.efc_work
+    e[EFC_SCALAR, count], e[EFC_SIGN, count] = s, sign
+    velocity = sign * scalar_value(m.scalar_v, s, qd)
+    e[EFC_AREF, count] = -damping * velocity - stiffness * imp * (distance - margin)
+    e[EFC_R, count] = max(_MIN_VALUE, (1.0 - imp) / imp * row[INVWEIGHT])
+    e[EFC_LOW, count], e[EFC_HIGH, count] = low, high
+    e[EFC_FORCE, count] = 0.0
+    return count + 1
+
+
+@inline
+def solve_constraints(m, w, q, qd, factor, h, qdd):
+    """Add the limits' and dry friction's accelerations to ``qdd`` (which holds ``q̈₀``); ``factor``: ``H``'s LTDL
+    factor (``dynamics.ltdl_factor``). Returns the number of active rows (their data stay in ``w.efc_work``)."""
+    scalar_reals = m.scalar_reals
+    count = 0
+    for s in range(scalar_reals.shape[0]):
+        row = scalar_reals[s]
+        loss = row[FRICTIONLOSS]
+        if loss > 0.0:
+            count = _add_row(m, w, count, s, 1.0, 0.0, 0.0, FRICTION_SOLREF, FRICTION_SOLIMP, -loss, loss, qd, h)
+        if row[LIMITED] != 0.0:
+            length, margin = scalar_value(m.scalar_q, s, q), row[MARGIN]
+            if length - row[LOWER] < margin:
+                count = _add_row(m, w, count, s, 1.0, length - row[LOWER], margin, LIMIT_SOLREF, LIMIT_SOLIMP, 0.0,
+                                 math.inf, qd, h)  # fmt: skip
+            if row[UPPER] - length < margin:
+                count = _add_row(m, w, count, s, -1.0, row[UPPER] - length, margin, LIMIT_SOLREF, LIMIT_SOLIMP, 0.0,
+                                 math.inf, qd, h)  # fmt: skip
+    if count == 0:
+        return 0
+    e, minv_jt, matrix, nv = w.efc_work, w.efc_minv_jt, w.efc_matrix, qdd.shape[0]
+    for i in range(count):  # H⁻¹ Jᵢᵀ, then A = J H⁻¹ Jᵀ and the offsets J q̈₀ - aref
+        s, sign = int(e[EFC_SCALAR, i]), e[EFC_SIGN, i]
+        for k in range(nv):
+            minv_jt[i, k] = sign * m.scalar_v[s, k]
+        ltdl_solve(m.dof_ints, factor, minv_jt[i])
+        e[EFC_OFFSET, i] = sign * scalar_value(m.scalar_v, s, qdd) - e[EFC_AREF, i]
+    for i in range(count):
+        s, sign = int(e[EFC_SCALAR, i]), e[EFC_SIGN, i]
+        for j in range(count):
+            matrix[i, j] = sign * scalar_value(m.scalar_v, s, minv_jt[j])
+    for _ in range(_MAX_SWEEPS):  # projected Gauss-Seidel on the dual
+        largest, change = 0.0, 0.0
+        for i in range(count):
+            residual = e[EFC_OFFSET, i] + e[EFC_R, i] * e[EFC_FORCE, i]
+            for j in range(count):
+                residual += matrix[i, j] * e[EFC_FORCE, j]
+            old = e[EFC_FORCE, i]
+            new = min(max(old - residual / (matrix[i, i] + e[EFC_R, i]), e[EFC_LOW, i]), e[EFC_HIGH, i])
+            e[EFC_FORCE, i] = new
+            change = max(change, abs(new - old))
+            largest = max(largest, abs(new))
+        if change <= _TOLERANCE * largest:
+            break
+    for i in range(count):
+        force = e[EFC_FORCE, i]
+        for k in range(nv):
+            qdd[k] += force * minv_jt[i, k]
+    return count
