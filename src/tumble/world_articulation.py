@@ -33,9 +33,10 @@ def _check(art) -> None:
             f"the articulation has {len(art.actuators)} actuators: world joints have none; step the "
             "articulation on its own, or apply their forces (WorldArticulation.apply_joint_forces)"
         )
-    if art.tendons:
-        raise ValueError(f"the articulation has {len(art.tendons)} tendons: world joints have none; step the "
-                         "articulation on its own")  # fmt: skip
+    if art.tendons or art.geoms:
+        raise ValueError(f"the articulation has {len(art.tendons)} tendons and {len(art.geoms)} geoms: a world "
+                         "collides its bodies' shapes, and its joints have no tendons; step the articulation on its "
+                         "own")  # fmt: skip
     for link in art.links:
         label = link.name or link.index
         if link.limits is not None or link.frictionloss != 0.0:

@@ -120,8 +120,12 @@ def test_bad_articulations_are_refused():
         world.add_articulation(limited)
     tendon = Articulation()
     tendon.add_tendon([tendon.add_link(Revolute((0, 1, 0)), shape=ROD, mass=1.0)], [1.0], stiffness=2.0)
-    with pytest.raises(ValueError, match="the articulation has 1 tendons: world joints have none"):
+    with pytest.raises(ValueError, match="the articulation has 1 tendons and 0 geoms"):
         world.add_articulation(tendon)
+    touching = Articulation()
+    touching.add_geom(touching.add_link(Revolute((0, 1, 0)), shape=ROD, mass=1.0), "sphere", (0.1,))
+    with pytest.raises(ValueError, match="the articulation has 0 tendons and 1 geoms"):
+        world.add_articulation(touching)
     assert world.bodies == [] and world.joints == []
 
 

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import os
 import warnings
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -20,7 +21,8 @@ gymnasium = pytest.importorskip("gymnasium")
 dm_control = pytest.importorskip("dm_control")
 
 from tumble.articulation import Articulation, Revolute, SoftConstraint, from_mjcf  # noqa: E402
-from tumble.models.mjcf import MJCFError  # noqa: E402
+from tumble.models.build import to_articulation  # noqa: E402
+from tumble.models.mjcf import MJCFError, read_mjcf  # noqa: E402
 
 GYMNASIUM = os.path.join(os.path.dirname(gymnasium.__file__), "envs", "mujoco", "assets")
 SUITE = os.path.join(os.path.dirname(dm_control.__file__), "suite")
@@ -65,10 +67,17 @@ def _mujoco_run(path: str, divisor: int, hold: int):
     return out, rows
 
 
-def _tumble_run(path: str):
+def _without_contacts(path: str):
+    """The model's articulation with no geoms to collide, as MuJoCo's with its contacts switched off."""
     with warnings.catch_warnings():
-        warnings.simplefilter("ignore")  # what the articulation leaves out (sensors, contacts) is not in play here
-        art = from_mjcf(path)
+        warnings.simplefilter("ignore")  # what the articulation leaves out (sensors) is not in play here
+        description = read_mjcf(path)
+    bodies = tuple(replace(body, geoms=()) for body in description.bodies)
+    return to_articulation(replace(description, bodies=bodies, world_geoms=()))
+
+
+def _tumble_run(path: str):
+    art = _without_contacts(path)
     model, _ = _mujoco(path, 10)
     dt = model.opt.timestep
     steps = round(DURATION / dt)

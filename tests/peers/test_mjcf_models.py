@@ -151,11 +151,12 @@ def _load(name: str, mujocos_mesh_inertia: bool = False):
 
 
 def _without_constraints(description):
-    """The description with its joints' and tendons' limits and dry friction, and its tendons' springs, taken out."""
-    bodies = tuple(replace(body, joints=tuple(replace(j, range=None, frictionloss=0.0) for j in body.joints))
-                   for body in description.bodies)  # fmt: skip
+    """The description with its joints' and tendons' limits and dry friction, its tendons' springs and its geoms'
+    contacts taken out (the geoms' mass is already in the bodies')."""
+    bodies = tuple(replace(body, joints=tuple(replace(j, range=None, frictionloss=0.0) for j in body.joints),
+                           geoms=()) for body in description.bodies)  # fmt: skip
     tendons = tuple(replace(t, range=None, frictionloss=0.0, stiffness=0.0, damping=0.0) for t in description.tendons)
-    return replace(description, bodies=bodies, tendons=tendons)
+    return replace(description, bodies=bodies, tendons=tendons, world_geoms=())
 
 
 def _driven(model) -> list[int]:

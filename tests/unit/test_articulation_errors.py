@@ -402,3 +402,42 @@ def test_bad_actuators(kwargs, error, message):
     with pytest.raises(error, match=message):
         art.add_actuator(**kwargs)
     assert art.actuators == () and art.ctrl.shape == (0,)
+
+
+@pytest.mark.parametrize(
+    ("args", "kwargs", "error", "message"),
+    [
+        ((0, "box", (1.0,)), {}, ValueError, r"kind must be one of \('plane', 'sphere', 'capsule'\), got 'box'"),
+        ((0, "plane"), {}, ValueError, r"a plane belongs to the world \(link=None\), got link=0"),
+        ((0, "sphere", (0.1, 0.2)), {}, ValueError, r"size must have shape \(1\)"),
+        ((0, "capsule", (0.1, -0.2)), {}, ValueError, r"size must be positive for a capsule, got \(0.1, -0.2\)"),
+        ((5, "sphere", (0.1,)), {}, ValueError, r"link must be"),
+        ((0, "sphere", (0.1,)), {"contype": -1}, ValueError, r"contype must be a non-negative integer, got -1"),
+        ((0, "sphere", (0.1,)), {"conaffinity": 1.5}, ValueError, r"conaffinity must be a non-negative integer"),
+        ((0, "sphere", (0.1,)), {"condim": 6}, ValueError, r"condim must be 1 or 3, got 6"),
+        ((0, "sphere", (0.1,)), {"friction": -1.0}, ValueError, r"friction must be >= 0, got -1.0"),
+        ((0, "sphere", (0.1,)), {"margin": -1.0}, ValueError, r"margin must be >= 0, got -1.0"),
+        ((0, "sphere", (0.1,)), {"softness": (0.02, 1.0)}, TypeError, r"softness must be a SoftConstraint or None"),
+        ((0, "sphere", (0.1,)), {"orientation": (0, 0, 0, 0)}, ValueError, r"orientation must be a non-zero"),
+    ],
+)
+def test_bad_geoms(args, kwargs, error, message):
+    art = pendulum()
+    before = _state(art)
+    with pytest.raises(error, match=message):
+        art.add_geom(*args, **kwargs)
+    assert art.geoms == ()
+    _unchanged(art, before)
+
+
+def test_geoms_and_loop_closures_are_not_simulated_together():
+    art = pendulum()
+    art.add_geom(0, "sphere", (0.1,))
+    with pytest.raises(ValueError, match="loop closures are not simulated with limits, frictionloss, tendons or geoms"):
+        art.add_loop_closure(1, (0, 0, 0), None, (0, 0, -2))
+    looped = Articulation()
+    looped.add_link(Revolute((0, 1, 0)), mass=1.0, shape_position=(0, 0, -1))
+    looped.add_loop_closure(0, (0, 0, -1), None, (0, 0, -1))
+    with pytest.raises(ValueError, match="contacts are not simulated with loop closures"):
+        looped.add_geom(0, "sphere", (0.1,))
+    assert looped.geoms == ()

@@ -15,8 +15,9 @@ Inverse dynamics by RNEA, the mass matrix by CRBA, forward dynamics by its spars
 from __future__ import annotations
 
 from .actuators import Actuator
-from .articulation import Articulation, ArticulationTrajectory, Link
+from .articulation import Articulation, ArticulationContacts, ArticulationTrajectory, Link
 from .batch import ArticulationBatch
+from .collision import Geom
 from .joints import Ball, Fixed, Free, Joint, JointType, Prismatic, Revolute
 from .limits import SoftConstraint, Tendon
 from .loops import LoopClosure
@@ -52,10 +53,12 @@ __all__ = [
     "Actuator",
     "Articulation",
     "ArticulationBatch",
+    "ArticulationContacts",
     "ArticulationTrajectory",
     "Ball",
     "Fixed",
     "Free",
+    "Geom",
     "Joint",
     "JointType",
     "Link",

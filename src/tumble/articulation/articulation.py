@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import numbers
 from dataclasses import dataclass, field
+from typing import NamedTuple
 
 import numpy as np
 
@@ -31,13 +32,18 @@ from ..mass import MassProperties
 from ..rotation import quat_from_rotvec, quat_multiply, quat_to_matrix
 from ..shapes import Shape
 from .actuators import Actuator
+from .collision import Collisions, Geom, geom_rows, pair_rows, pair_weights, translation_weight
 from .drives import JointDrives, softness
 from .integrators import EULER, NOT_FINITE, RK4, SYMPLECTIC
 from .joints import Ball, Free, Joint, Prismatic, Revolute
-from .kernels import FORWARD, INVERSE, KINEMATICS, MASS_MATRIX, PROJECT, SIMULATE, articulation_kernel
+from .kernels import CONTACTS, FORWARD, INVERSE, KINEMATICS, MASS_MATRIX, PROJECT, SIMULATE, articulation_kernel
 from .limits import SoftConstraint, Tendon, actuator_rows, check_limits, invweights, readonly, scalar_rows
 from .loops import LoopClosure
 from .model import (
+    CONTACT_DIST,
+    CONTACT_NORMAL,
+    CONTACT_PAIR,
+    CONTACT_POINT,
     DOF_PARENT,
     DOF_TIP,
     INERTIA_WORLD,
@@ -54,7 +60,16 @@ from .model import (
     work_views,
 )
 
-__all__ = ["Actuator", "Articulation", "ArticulationTrajectory", "Link", "SoftConstraint", "Tendon"]
+__all__ = [
+    "Actuator",
+    "Articulation",
+    "ArticulationContacts",
+    "ArticulationTrajectory",
+    "Geom",
+    "Link",
+    "SoftConstraint",
+    "Tendon",
+]
 
 INTEGRATORS = {"euler": EULER, "symplectic": SYMPLECTIC, "rk4": RK4}
 LOOP_KINDS = ("point",)
@@ -102,6 +117,17 @@ class Link:
     friction_softness: SoftConstraint = field(default_factory=SoftConstraint)
 
 
+class ArticulationContacts(NamedTuple):
+    """Contacts of an articulation's geoms (:meth:`Articulation.contacts`): ``geoms`` (k, 2) the two geoms (the
+    normal points from the first to the second), ``point`` (k, 3) [m] midway between their surfaces, ``normal``
+    (k, 3), ``distance`` (k,) [m] (negative: overlapping)."""
+
+    geoms: np.ndarray
+    point: np.ndarray
+    normal: np.ndarray
+    distance: np.ndarray
+
+
 @dataclass(frozen=True, eq=False)
 class ArticulationTrajectory:
     """Recorded frames of :meth:`Articulation.simulate`.
@@ -143,7 +169,7 @@ class _Compiled:
         return model, python_function(work_views)(self.work, *counts(self.ints))
 
 
-class Articulation(JointDrives):
+class Articulation(JointDrives, Collisions):
     """A tree of rigid links joined by joints, in generalised coordinates.
 
     Args:
@@ -178,6 +204,9 @@ class Articulation(JointDrives):
         self._actuators: list[Actuator] = []
         self._ctrl = np.zeros(0)
         self._tendons: list[Tendon] = []
+        self._geoms: list[Geom] = []
+        self._excluded: set[frozenset] = set()
+        self._impratio = 1.0
 
     # --- building ------------------------------------------------------------------------------------
 
@@ -274,7 +303,7 @@ class Articulation(JointDrives):
         if not isinstance(kind, str) or kind not in LOOP_KINDS:
             raise ValueError(f"kind must be one of {LOOP_KINDS}, got {_show(kind)}")
         if self._has_soft_constraints():
-            raise ValueError("loop closures are not simulated with limits, frictionloss or tendons (yet); this "
+            raise ValueError("loop closures are not simulated with limits, frictionloss, tendons or geoms (yet); this "
                              "articulation has some")  # fmt: skip
         loop = LoopClosure(len(self._loops), link_a, readonly(as_vector3("point_a", point_a)), link_b,
                            readonly(as_vector3("point_b", point_b)), kind)  # fmt: skip
@@ -283,7 +312,8 @@ class Articulation(JointDrives):
         return loop.index
 
     def _has_soft_constraints(self) -> bool:
-        return bool(self._tendons) or any(link.limits is not None or link.frictionloss > 0.0 for link in self._links)
+        limited = any(link.limits is not None or link.frictionloss > 0.0 for link in self._links)
+        return limited or bool(self._tendons) or bool(self._geoms)
 
     # --- description -----------------------------------------------------------------------------------
 
@@ -400,6 +430,29 @@ class Articulation(JointDrives):
             jac[3:, k] = angular
             k = int(m.dof_ints[k, DOF_PARENT])
         return jac
+
+    def contacts(self, q=None) -> ArticulationContacts:
+        """The contacts of the geoms at ``q`` (default the current coordinates): MuJoCo's, within each pair's margin."""
+        c = self._compile()
+        q = self._q.copy() if q is None else self._check_q("q", q)
+        found, _, _ = articulation_kernel(c.ints, c.reals, q, c.zero_v, c.zero_v, c.zero_external, False, c.work,
+                                          c.out_v, c.no_record, 0.0, 0, 0, 1, CONTACTS)  # fmt: skip
+        model, w = c.views()
+        rows = w.contact_work[:found]
+        pairs = model.pair_ints[rows[:, CONTACT_PAIR].astype(np.int64)]
+        return ArticulationContacts(pairs[:, :2].copy(), rows[:, CONTACT_POINT : CONTACT_POINT + 3].copy(),
+                                    rows[:, CONTACT_NORMAL : CONTACT_NORMAL + 3].copy(),
+                                    rows[:, CONTACT_DIST].copy())  # fmt: skip
+
+    @property
+    def impratio(self) -> float:
+        """MuJoCo's ``impratio`` (> 0, default 1): the contacts' friction rows are weighted by ``1 / impratio``."""
+        return self._impratio
+
+    @impratio.setter
+    def impratio(self, value) -> None:
+        self._impratio = as_float("impratio", value, positive=True)
+        self._compiled = None
 
     def com(self, q=None) -> np.ndarray:
         """(3,) [m]: the centre of mass of all links, world frame."""
@@ -562,23 +615,33 @@ class Articulation(JointDrives):
             rows = actuator_rows(self._actuators, lambda a: link_scalar[a.link] if a.tendon is None
                                  else tendon_scalar[a.tendon], self._ctrl)  # fmt: skip
             ints, reals = pack_model(self._links, self._loops, self._gravity, self._base_position,
-                                     self._base_orientation, scalars, rows)  # fmt: skip
-            n, nq, nv, nl, ns = counts(ints)
+                                     self._base_orientation, scalars, rows, geom_rows(self._geoms),
+                                     pair_rows(self._links, self._geoms, self._excluded))  # fmt: skip
+            n, nq, nv, nl, ns, nc = counts(ints)
             self._compiled = _Compiled(
-                ints, reals, np.zeros(work_size(n, nq, nv, nl, ns)), np.zeros(nv), np.zeros((n, 6)), np.zeros(nv),
+                ints, reals, np.zeros(work_size(n, nq, nv, nl, ns, nc)), np.zeros(nv), np.zeros((n, 6)), np.zeros(nv),
                 np.zeros((0, nq + nv + 1)),
             )  # fmt: skip
-            if ns:
-                model = self._compiled.views()[0]
-                model.scalar_reals[:, INVWEIGHT] = invweights(self._links, model.scalar_v, self._initial_mass_matrix())
+            model = self._compiled.views()[0]
+            if ns or len(model.pair_ints):
+                initial = np.concatenate([_initial_coordinates(link) for link in self._links])
+                mass_matrix = self._initial_mass_matrix(initial)
+                model.scalar_reals[:, INVWEIGHT] = invweights(self._links, model.scalar_v, mass_matrix)
+                weights = {link: translation_weight(self.jacobian(link, self._com_point(link), initial), mass_matrix)
+                           for link in {g.link for g in self._geoms if g.link is not None}}  # fmt: skip
+                pair_weights(model.pair_ints, model.pair_reals, self._geoms, weights, self._impratio)
         return self._compiled
 
-    def _initial_mass_matrix(self) -> np.ndarray:
-        """``H`` at the links' zero displacement (a free joint at its initial pose): MuJoCo's ``qpos0``, where it
-        weighs its constraints (``invweight0``)."""
-        initial = np.concatenate([_initial_coordinates(link) for link in self._links])
+    def _initial_mass_matrix(self, initial) -> np.ndarray:
+        """``H`` at the links' zero displacement ``initial`` (a free joint at its initial pose): MuJoCo's ``qpos0``,
+        where it weighs its constraints (``invweight0``)."""
         _, w = self._evaluate(MASS_MATRIX, q=initial, qd=self._compiled.zero_v)
         return w.mass_matrix.copy()
+
+    def _com_point(self, link: int) -> np.ndarray:
+        """A link's centre of mass in its frame (its origin when massless)."""
+        properties = self._links[link].mass_properties
+        return np.zeros(3) if properties is None else properties.com
 
     def _evaluate(self, mode, *, q=None, qd=None, vec_in=None, external=None, require_all=False):
         """Validate the state arguments, run one query of the kernel and return the model and work views."""

@@ -36,7 +36,6 @@ from .model import (
     EFC_OFFSET,
     EFC_R,
     EFC_SCALAR,
-    EFC_SIGN,
     FORCE0,
     FORCE_HIGH,
     FORCE_LOW,
@@ -56,7 +55,7 @@ from .model import (
     UPPER,
 )
 
-__all__ = ["applied_forces", "constrained", "impedance", "scalar_value", "solve_constraints"]
+__all__ = ["applied_forces", "constrained", "impedance", "scalar_rows", "scalar_value", "soft_row", "solve_constraints"]
 
 # MuJoCo's mjMINVAL: the smallest regulariser
 _MIN_VALUE = 1e-15
@@ -76,7 +75,10 @@ def scalar_value(coefficients, s, x):
 
 @inline
 def constrained(m):
-    """Whether any scalar has a limit or dry friction (the model then solves constraints at every evaluation)."""
+    """Whether any scalar has a limit or dry friction, or geoms may touch (the model then solves constraints at
+    every evaluation)."""
+    if m.pair_ints.shape[0] > 0:
+        return True
     for s in range(m.scalar_reals.shape[0]):
         if m.scalar_reals[s, LIMITED] != 0.0 or m.scalar_reals[s, FRICTIONLOSS] > 0.0:
             return True
@@ -135,63 +137,86 @@ def impedance(row, c, distance):
 
 
 @inline
-def _add_row(m, w, count, s, sign, distance, margin, ref_column, imp_column, low, high, qd, h):
-    """Append constraint row ``count`` of scalar ``s`` (its Jacobian ``sign · scalar_v[s]``) to ``w.efc_work``: a
-    limit (``high`` infinite) or dry friction (``low = -high``, which has no position term)."""
-    row = m.scalar_reals[s]
-    imp = impedance(row, imp_column, distance - margin)
-    time_constant, damping_ratio = row[ref_column], row[ref_column + 1]
-    d_max = row[imp_column + 1]
+def soft_row(w, count, tag, distance, margin, refs, imps, weight, low, high, h, qd):
+    """Fill constraint row ``count`` (its Jacobian already in ``w.efc_jac[count]``): MuJoCo's reference acceleration and
+    regulariser for the violation ``distance`` less ``margin`` (zero for dry friction, which has no position term),
+    the solref ``refs[0:2]`` and solimp ``imps[0:5]``, ``weight`` its ``diagApprox``, and the force's bounds. ``tag``:
+    the scalar, or -1 - the contact. Returns ``count + 1``."""
+    imp = impedance(imps, 0, distance - margin)
+    time_constant, damping_ratio, d_max = refs[0], refs[1], imps[1]
     if time_constant > 0.0:
         time_constant = max(time_constant, 2.0 * h)
         stiffness = 1.0 / (d_max * d_max * time_constant * time_constant * damping_ratio * damping_ratio)
         damping = 2.0 / (d_max * time_constant)
     else:
         stiffness, damping = -time_constant / (d_max * d_max), -damping_ratio / d_max
-    if high != math.inf:
+    if low < 0.0:  # dry friction: no position term
         stiffness = 0.0
-    e = w.efc_work
-    e[EFC_SCALAR, count], e[EFC_SIGN, count] = s, sign
-    velocity = sign * scalar_value(m.scalar_v, s, qd)
+    e, jac = w.efc_work, w.efc_jac
+    velocity = 0.0
+    for k in range(qd.shape[0]):
+        velocity += jac[count, k] * qd[k]
+    e[EFC_SCALAR, count] = tag
     e[EFC_AREF, count] = -damping * velocity - stiffness * imp * (distance - margin)
-    e[EFC_R, count] = max(_MIN_VALUE, (1.0 - imp) / imp * row[INVWEIGHT])
+    e[EFC_R, count] = max(_MIN_VALUE, (1.0 - imp) / imp * weight)
     e[EFC_LOW, count], e[EFC_HIGH, count] = low, high
     e[EFC_FORCE, count] = 0.0
     return count + 1
 
 
 @inline
-def solve_constraints(m, w, q, qd, factor, h, qdd):
-    """Add the limits' and dry friction's accelerations to ``qdd`` (which holds ``q̈₀``); ``factor``: ``H``'s LTDL
-    factor (``dynamics.ltdl_factor``). Returns the number of active rows (their data stay in ``w.efc_work``)."""
+def _scalar_row(m, w, count, s, sign, distance, kind, low, high, h, qd):
+    """A row of scalar ``s``: its Jacobian ``sign · scalar_v[s]``, the limit's (``kind`` LIMIT_SOLREF) or the dry
+    friction's settings."""
+    row = m.scalar_reals[s]
+    for k in range(qd.shape[0]):
+        w.efc_jac[count, k] = sign * m.scalar_v[s, k]
+    imps = row[LIMIT_SOLIMP : LIMIT_SOLIMP + 5] if kind == LIMIT_SOLREF else row[FRICTION_SOLIMP : FRICTION_SOLIMP + 5]
+    margin = row[MARGIN] if kind == LIMIT_SOLREF else 0.0
+    return soft_row(w, count, s, distance, margin, row[kind : kind + 2], imps, row[INVWEIGHT], low, high, h, qd)
+
+
+@inline
+def scalar_rows(m, w, q, qd, h):
+    """The active rows of the scalars' limits and dry friction into ``w.efc_*``; returns their count."""
     scalar_reals = m.scalar_reals
     count = 0
     for s in range(scalar_reals.shape[0]):
         row = scalar_reals[s]
         loss = row[FRICTIONLOSS]
         if loss > 0.0:
-            count = _add_row(m, w, count, s, 1.0, 0.0, 0.0, FRICTION_SOLREF, FRICTION_SOLIMP, -loss, loss, qd, h)
+            count = _scalar_row(m, w, count, s, 1.0, 0.0, FRICTION_SOLREF, -loss, loss, h, qd)
         if row[LIMITED] != 0.0:
             length, margin = scalar_value(m.scalar_q, s, q), row[MARGIN]
             if length - row[LOWER] < margin:
-                count = _add_row(m, w, count, s, 1.0, length - row[LOWER], margin, LIMIT_SOLREF, LIMIT_SOLIMP, 0.0,
-                                 math.inf, qd, h)  # fmt: skip
+                count = _scalar_row(m, w, count, s, 1.0, length - row[LOWER], LIMIT_SOLREF, 0.0, math.inf, h, qd)
             if row[UPPER] - length < margin:
-                count = _add_row(m, w, count, s, -1.0, row[UPPER] - length, margin, LIMIT_SOLREF, LIMIT_SOLIMP, 0.0,
-                                 math.inf, qd, h)  # fmt: skip
+                count = _scalar_row(m, w, count, s, -1.0, row[UPPER] - length, LIMIT_SOLREF, 0.0, math.inf, h, qd)
+    return count
+
+
+@inline
+def solve_constraints(m, w, count, factor, qdd):
+    """Add the accelerations of the ``count`` active constraint rows in ``w.efc_*`` to ``qdd`` (which holds ``q̈₀``);
+    ``factor``: ``H``'s LTDL factor (``dynamics.ltdl_factor``). The rows' forces stay in ``w.efc_work``."""
     if count == 0:
-        return 0
-    e, minv_jt, matrix, nv = w.efc_work, w.efc_minv_jt, w.efc_matrix, qdd.shape[0]
+        return
+    e, jac, minv_jt, matrix, nv = w.efc_work, w.efc_jac, w.efc_minv_jt, w.efc_matrix, qdd.shape[0]
     for i in range(count):  # H⁻¹ Jᵢᵀ, then A = J H⁻¹ Jᵀ and the offsets J q̈₀ - aref
-        s, sign = int(e[EFC_SCALAR, i]), e[EFC_SIGN, i]
         for k in range(nv):
-            minv_jt[i, k] = sign * m.scalar_v[s, k]
+            minv_jt[i, k] = jac[i, k]
         ltdl_solve(m.dof_ints, factor, minv_jt[i])
-        e[EFC_OFFSET, i] = sign * scalar_value(m.scalar_v, s, qdd) - e[EFC_AREF, i]
+        offset = 0.0
+        for k in range(nv):
+            offset += jac[i, k] * qdd[k]
+        e[EFC_OFFSET, i] = offset - e[EFC_AREF, i]
     for i in range(count):
-        s, sign = int(e[EFC_SCALAR, i]), e[EFC_SIGN, i]
-        for j in range(count):
-            matrix[i, j] = sign * scalar_value(m.scalar_v, s, minv_jt[j])
+        for j in range(i, count):
+            total = 0.0
+            for k in range(nv):
+                total += jac[i, k] * minv_jt[j, k]
+            matrix[i, j] = total
+            matrix[j, i] = total
     for _ in range(_MAX_SWEEPS):  # projected Gauss-Seidel on the dual
         largest, change = 0.0, 0.0
         for i in range(count):
@@ -209,4 +234,3 @@ def solve_constraints(m, w, q, qd, factor, h, qdd):
         force = e[EFC_FORCE, i]
         for k in range(nv):
             qdd[k] += force * minv_jt[i, k]
-    return count

@@ -25,7 +25,8 @@ import math
 from .._jit import inline
 from ..math3d import add, add_scaled, cross, scale
 from .aba import aba
-from .constraints import applied_forces, constrained, solve_constraints
+from .constraints import applied_forces, constrained, scalar_rows, solve_constraints
+from .contacts import contact_rows, find_contacts
 from .dynamics import crba, ltdl_factor, ltdl_solve, rnea
 from .joints import JointType
 from .kinematics import forward_kinematics, integrate_configuration
@@ -83,7 +84,10 @@ def accelerations(m, w, q, qd, tau, external, use_external, step_size):
         qdd[k] = tau[k] - bias[k]
     ltdl_solve(m.dof_ints, h, qdd)
     if limited:
-        solve_constraints(m, w, q, qd, h, step_size, qdd)
+        count = scalar_rows(m, w, q, qd, step_size)
+        if m.pair_ints.shape[0] > 0:
+            count = contact_rows(m, w, find_contacts(m, w), count, qd, step_size)
+        solve_constraints(m, w, count, h, qdd)
     if m.loop_ints.shape[0] > 0:
         loop_jacobian(link_ints, m.dof_ints, m.loop_ints, m.loop_reals, link_work, dof_motion, w.loop_jac,
                       w.loop_work)  # fmt: skip

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 from .._jit import inline, kernel
 from .constraints import applied_forces
+from .contacts import find_contacts
 from .dynamics import crba, joint_energies, rnea
 from .integrators import accelerations, step
 from .kinematics import energies, forward_kinematics
@@ -26,11 +27,12 @@ __all__ = [
     "MASS_MATRIX",
     "PROJECT",
     "SIMULATE",
+    "CONTACTS",
     "articulation_kernel",
     "batch_kernel",
 ]
 
-KINEMATICS, INVERSE, MASS_MATRIX, FORWARD, PROJECT, SIMULATE = 0, 1, 2, 3, 4, 5
+KINEMATICS, INVERSE, MASS_MATRIX, FORWARD, PROJECT, SIMULATE, CONTACTS = 0, 1, 2, 3, 4, 5, 6
 
 
 @inline
@@ -57,13 +59,13 @@ def articulation_kernel(ints, reals, q, qd, vec_in, external, use_external, work
         h [s], method (``integrators.EULER``/``SYMPLECTIC``/``RK4``), steps: the time loop of ``SIMULATE``.
         mode: ``KINEMATICS`` (poses, velocities, energies, closure errors in ``work``), ``INVERSE``,
             ``MASS_MATRIX`` (``H`` in ``work``), ``FORWARD``, ``PROJECT`` (``q``, ``qd`` onto the loop
-            closures), ``SIMULATE``.
+            closures), ``SIMULATE``, ``CONTACTS`` (the contacts in ``work``; their count is the first result).
 
     ``status``: 0 done; 1 a singular mass matrix (``where`` its row); 2 a non-finite state (``where`` the link;
     ``SIMULATE`` only, the state is that before the failing step).
     """
     m = model_views(ints, reals)
-    w = work_views(work, ints[0], ints[1], ints[2], ints[3], ints[4])
+    w = work_views(work, ints[0], ints[1], ints[2], ints[3], ints[4], ints[8])
     if mode == FORWARD or mode == PROJECT:
         bad = accelerations(m, w, q, qd, vec_in, external, use_external, 0.0)
         if bad >= 0:
@@ -75,6 +77,8 @@ def articulation_kernel(ints, reals, q, qd, vec_in, external, use_external, work
         return 0, 0, -1
     if mode != SIMULATE:
         forward_kinematics(m.link_ints, m.link_reals, m.world, q, qd, w.link_work, w.dof_motion)
+        if mode == CONTACTS:
+            return find_contacts(m, w), 0, -1
         if mode == KINEMATICS:
             w.energy[0], w.energy[1] = _energies(m, w, q, qd)
             if m.loop_ints.shape[0] > 0:
@@ -125,7 +129,7 @@ def batch_kernel(ints, reals, q, qd, tau, work, external, h, method, steps, firs
     buffer that it did not write first, so one buffer serves copy after copy (and stays in the cache).
     """
     m = model_views(ints, reals)
-    w = work_views(work, ints[0], ints[1], ints[2], ints[3], ints[4])
+    w = work_views(work, ints[0], ints[1], ints[2], ints[3], ints[4], ints[8])
     failed = 0
     for c in range(first, last):
         q_c, qd_c, tau_c = q[c], qd[c], tau[c]

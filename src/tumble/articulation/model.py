@@ -63,19 +63,40 @@ SCALAR_WIDTH = 23
 # ``[FORCE_LOW, FORCE_HIGH]``
 GEAR, FORCE0, BIAS_LENGTH, BIAS_SPEED, FORCE_LOW, FORCE_HIGH = 0, 1, 2, 3, 4, 5
 ACT_WIDTH = 6
+# geom_ints / geom_reals columns: a collision geom on a link (-1: the world), MuJoCo's primitive type and size
+# (sphere: radius; capsule: radius, half length along z; plane: its normal is z), its pose in the link frame
+GEOM_LINK, GEOM_TYPE = 0, 1
+GEOM_INT_WIDTH = 2
+GEOM_SIZE, GEOM_POS, GEOM_QUAT = 0, 3, 6
+GEOM_REAL_WIDTH = 10
+PLANE, SPHERE, CAPSULE = 0, 2, 3  # MuJoCo's mjtGeom numbers
+# pair_ints / pair_reals columns: two geoms that may touch (geom A's type <= geom B's), the contact's dimension (1: no
+# friction, 3: a pyramid of four edges), and MuJoCo's mixed settings: friction, margin, solref (2), solimp (5) and the
+# regulariser's weight (``diagApprox``: both bodies' ``invweight0``, and for a pyramid ``2 μ² (1 + μ²) / impratio``)
+PAIR_A, PAIR_B, PAIR_CONDIM = 0, 1, 2
+PAIR_INT_WIDTH = 3
+PAIR_FRICTION, PAIR_MARGIN, PAIR_SOLREF, PAIR_SOLIMP, PAIR_WEIGHT = 0, 1, 2, 4, 9
+PAIR_REAL_WIDTH = 10
+MAX_PAIR_CONTACTS = 2  # a capsule on a plane touches at both ends
+# contact_work columns: a contact's point (world), normal (from geom A to B), distance, pair, and the direction its
+# first tangent is made from (zero: MuJoCo's default)
+CONTACT_POINT, CONTACT_NORMAL, CONTACT_DIST, CONTACT_PAIR, CONTACT_TANGENT = 0, 3, 6, 7, 8
+CONTACT_WIDTH = 11
 # dof_work rows
 BIAS, RHS, QDD, DIAG, QD_START, QD_STAGE, QDD_SUM, QD_SUM, CHART, APPLIED = 0, 1, 2, 3, 4, 5, 6, 7, 8, 9
 DOF_WORK_ROWS = 10
 # loop_work rows
 LOOP_RHS, LOOP_LAMBDA, LOOP_ACTIVE, LOOP_ERROR = 0, 1, 2, 3
 LOOP_WORK_ROWS = 4
-# efc_work rows, one column per constraint row (at most three a scalar: its friction and its two limits):
-# the scalar, the row's sign (its Jacobian is ``sign · scalar_v``), MuJoCo's reference acceleration and
-# regulariser R, the force's bounds, the force, and ``J q̈_smooth - aref``
-EFC_SCALAR, EFC_SIGN, EFC_AREF, EFC_R, EFC_LOW, EFC_HIGH, EFC_FORCE, EFC_OFFSET = 0, 1, 2, 3, 4, 5, 6, 7
-EFC_WORK_ROWS = 8
+# efc_work rows, one column per constraint row (at most three a scalar: its friction and its two limits; four a
+# contact): the scalar (or -1 - contact), MuJoCo's reference acceleration and regulariser R, the force's bounds,
+# the force, and ``J q̈_smooth - aref``
+EFC_SCALAR, EFC_AREF, EFC_R, EFC_LOW, EFC_HIGH, EFC_FORCE, EFC_OFFSET = 0, 1, 2, 3, 4, 5, 6
+EFC_WORK_ROWS = 7
 
-_HEADER = 6  # ints[0:6] = link_count, q_count, v_count, loop_count, scalar_count, actuator_count
+# ints[0:9] = link_count, q_count, v_count, loop_count, scalar_count, actuator_count, geom_count, pair_count and
+# the contacts the pairs can make at most
+_HEADER = 9
 
 
 class Model(NamedTuple):
@@ -98,6 +119,8 @@ class Model(NamedTuple):
         scalar_q: (S, nq), scalar_v: (S, nv): each scalar's coefficients (a joint's or a fixed tendon's length).
         scalar_reals: (S, 23): its limits, dry friction and tendon spring (the columns above).
         act_ints: (A, 1) int64: each actuator's scalar; act_reals: (A, 6): its force law (the columns above).
+        geom_ints: (G, 2) int64, geom_reals: (G, 10): the collision geoms; pair_ints: (P, 3) int64, pair_reals:
+            (P, 10): the pairs that may touch (the columns above).
     """
 
     link_ints: np.ndarray
@@ -112,6 +135,10 @@ class Model(NamedTuple):
     scalar_reals: np.ndarray
     act_ints: np.ndarray
     act_reals: np.ndarray
+    geom_ints: np.ndarray
+    geom_reals: np.ndarray
+    pair_ints: np.ndarray
+    pair_reals: np.ndarray
 
 
 class Work(NamedTuple):
@@ -137,8 +164,9 @@ class Work(NamedTuple):
         loop_matrix: (3L, 3L): ``J H⁻¹ Jᵀ`` or its factor.
         loop_work: (4, 3L): rows ``LOOP_RHS`` (γ), ``LOOP_LAMBDA``, ``LOOP_ACTIVE``, ``LOOP_ERROR`` (φ).
         energy: (2,) [J]: kinetic and potential.
-        efc_minv_jt: (3S, nv): ``H⁻¹ Jᵀ`` of each active constraint row; efc_matrix: (3S, 3S): ``J H⁻¹ Jᵀ``;
-        efc_work: (8, 3S): the rows' data (the ``EFC_*`` rows above).
+        contact_work: (C, 11): the contacts found (the ``CONTACT_*`` columns), C the most the pairs can make.
+        efc_jac: (rows, nv): the Jacobian of each active constraint row, rows = 3S + 4C; efc_minv_jt: (rows, nv):
+            ``H⁻¹ Jᵀ``; efc_matrix: (rows, rows): ``J H⁻¹ Jᵀ``; efc_work: (7, rows): the rows' data (``EFC_*``).
     """
 
     link_work: np.ndarray
@@ -153,25 +181,28 @@ class Work(NamedTuple):
     loop_matrix: np.ndarray
     loop_work: np.ndarray
     energy: np.ndarray
+    contact_work: np.ndarray
+    efc_jac: np.ndarray
     efc_minv_jt: np.ndarray
     efc_matrix: np.ndarray
     efc_work: np.ndarray
 
 
-def _int_size(n: int, nv: int, loops: int, actuators: int) -> int:
-    return _HEADER + LINK_INT_WIDTH * n + 2 * nv + 2 * loops + actuators
+def _int_size(n: int, nv: int, loops: int, actuators: int, geoms: int, pairs: int) -> int:
+    return (_HEADER + LINK_INT_WIDTH * n + 2 * nv + 2 * loops + actuators + GEOM_INT_WIDTH * geoms
+            + PAIR_INT_WIDTH * pairs)  # fmt: skip
 
 
-def _real_size(n: int, nq: int, nv: int, loops: int, scalars: int, actuators: int) -> int:
+def _real_size(n: int, nq: int, nv: int, loops: int, scalars: int, actuators: int, geoms: int, pairs: int) -> int:
     return (WORLD_WIDTH + LINK_REAL_WIDTH * n + DOF_PARAM_WIDTH * nv + 6 * loops + scalars * (nq + nv + SCALAR_WIDTH)
-            + ACT_WIDTH * actuators)  # fmt: skip
+            + ACT_WIDTH * actuators + GEOM_REAL_WIDTH * geoms + PAIR_REAL_WIDTH * pairs)  # fmt: skip
 
 
-def work_size(n: int, nq: int, nv: int, loops: int, scalars: int) -> int:
+def work_size(n: int, nq: int, nv: int, loops: int, scalars: int, contacts: int) -> int:
     """The length of the work buffer that :func:`work_views` carves."""
-    nc, nr = 3 * loops, 3 * scalars
+    nc, nr = 3 * loops, 3 * scalars + 4 * contacts
     return (LINK_WORK_WIDTH * n + 12 * nv + nv * nv + DOF_WORK_ROWS * nv + 2 * nq + 2 * nc * nv + nc * nc + 4 * nc + 2
-            + nr * nv + nr * nr + EFC_WORK_ROWS * nr)  # fmt: skip
+            + CONTACT_WIDTH * contacts + 2 * nr * nv + nr * nr + EFC_WORK_ROWS * nr)  # fmt: skip
 
 
 @inline
@@ -187,13 +218,19 @@ def _rows(buffer, start, count, width):
 @inline
 def model_views(ints, reals):
     """Carve ``ints`` and ``reals`` into a :class:`Model` of views (no copies)."""
-    n, nq, nv, nl, ns, na = ints[0], ints[1], ints[2], ints[3], ints[4], ints[5]
+    n, nq, nv, nl, ns, na, ng, npairs = ints[0], ints[1], ints[2], ints[3], ints[4], ints[5], ints[6], ints[7]
     i = _HEADER
     link_ints = _rows(ints, i, n, LINK_INT_WIDTH)
     i += LINK_INT_WIDTH * n
     dof_ints = _rows(ints, i, nv, 2)
-    loop_ints = _rows(ints, i + 2 * nv, nl, 2)
-    act_ints = _rows(ints, i + 2 * nv + 2 * nl, na, 1)
+    i += 2 * nv
+    loop_ints = _rows(ints, i, nl, 2)
+    i += 2 * nl
+    act_ints = _rows(ints, i, na, 1)
+    i += na
+    geom_ints = _rows(ints, i, ng, GEOM_INT_WIDTH)
+    i += GEOM_INT_WIDTH * ng
+    pair_ints = _rows(ints, i, npairs, PAIR_INT_WIDTH)
     r = WORLD_WIDTH
     link_reals = _rows(reals, r, n, LINK_REAL_WIDTH)
     r += LINK_REAL_WIDTH * n
@@ -208,14 +245,18 @@ def model_views(ints, reals):
     scalar_reals = _rows(reals, r, ns, SCALAR_WIDTH)
     r += ns * SCALAR_WIDTH
     act_reals = _rows(reals, r, na, ACT_WIDTH)
+    r += na * ACT_WIDTH
+    geom_reals = _rows(reals, r, ng, GEOM_REAL_WIDTH)
+    r += ng * GEOM_REAL_WIDTH
+    pair_reals = _rows(reals, r, npairs, PAIR_REAL_WIDTH)
     return Model(link_ints, link_reals, dof_ints, dof_params, reals[0:WORLD_WIDTH], loop_ints, loop_reals, scalar_q,
-                 scalar_v, scalar_reals, act_ints, act_reals)  # fmt: skip
+                 scalar_v, scalar_reals, act_ints, act_reals, geom_ints, geom_reals, pair_ints, pair_reals)  # fmt: skip
 
 
 @inline
-def work_views(work, n, nq, nv, nl, ns):
+def work_views(work, n, nq, nv, nl, ns, ncontacts):
     """Carve ``work`` into a :class:`Work` of views."""
-    nc, nr = 3 * nl, 3 * ns
+    nc, nr = 3 * nl, 3 * ns + 4 * ncontacts
     link_work = _rows(work, 0, n, LINK_WORK_WIDTH)
     w = LINK_WORK_WIDTH * n
     dof_motion = _rows(work, w, nv, 6)
@@ -236,13 +277,17 @@ def work_views(work, n, nq, nv, nl, ns):
     w += LOOP_WORK_ROWS * nc
     energy = work[w : w + 2]
     w += 2
+    contact_work = _rows(work, w, ncontacts, CONTACT_WIDTH)
+    w += ncontacts * CONTACT_WIDTH
+    efc_jac = _rows(work, w, nr, nv)
+    w += nr * nv
     efc_minv_jt = _rows(work, w, nr, nv)
     w += nr * nv
     efc_matrix = _rows(work, w, nr, nr)
     w += nr * nr
     efc_work = _rows(work, w, EFC_WORK_ROWS, nr)
     return Work(link_work, dof_motion, dof_u, mass_matrix, dof_work, q_start, q_stage, loop_jac, loop_minv_jt,
-                loop_matrix, loop_work, energy, efc_minv_jt, efc_matrix, efc_work)  # fmt: skip
+                loop_matrix, loop_work, energy, contact_work, efc_jac, efc_minv_jt, efc_matrix, efc_work)  # fmt: skip
 
 
 def python_function(compiled):
@@ -250,13 +295,14 @@ def python_function(compiled):
     return getattr(compiled, "py_func", compiled)
 
 
-def counts(ints: np.ndarray) -> tuple[int, int, int, int, int]:
-    """``(link_count, q_count, v_count, loop_count, scalar_count)`` from the header of ``ints``: the arguments of
-    :func:`work_size` and :func:`work_views`."""
-    return int(ints[0]), int(ints[1]), int(ints[2]), int(ints[3]), int(ints[4])
+def counts(ints: np.ndarray) -> tuple[int, int, int, int, int, int]:
+    """``(link_count, q_count, v_count, loop_count, scalar_count, contact capacity)`` from the header of ``ints``:
+    the arguments of :func:`work_size` and :func:`work_views`."""
+    return int(ints[0]), int(ints[1]), int(ints[2]), int(ints[3]), int(ints[4]), int(ints[8])
 
 
-def pack_model(links, loops, gravity, base_pos, base_quat, scalars=(), actuators=()) -> tuple[np.ndarray, np.ndarray]:
+def pack_model(links, loops, gravity, base_pos, base_quat, scalars=(), actuators=(), geoms=(),
+               pairs=()) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
     """Build ``(ints, reals)`` from link and loop descriptions.
 
     Args:
@@ -265,13 +311,14 @@ def pack_model(links, loops, gravity, base_pos, base_quat, scalars=(), actuators
         gravity, base_pos: (3,); base_quat: (4,), unit.
         scalars: sequence of ``(q coefficients (nq,), v coefficients (nv,), the SCALAR_WIDTH columns)``.
         actuators: sequence of ``(scalar, the ACT_WIDTH columns)``.
+        geoms: sequence of ``(the GEOM_INT_WIDTH columns, the GEOM_REAL_WIDTH columns)``; pairs: likewise.
     """
-    n, nl, ns, na = len(links), len(loops), len(scalars), len(actuators)
+    n, nl, ns, na, ng, npairs = len(links), len(loops), len(scalars), len(actuators), len(geoms), len(pairs)
     nq = sum(link.joint.nq for link in links)
     nv = sum(link.joint.nv for link in links)
-    ints = np.zeros(_int_size(n, nv, nl, na), dtype=np.int64)
-    reals = np.zeros(_real_size(n, nq, nv, nl, ns, na), dtype=np.float64)
-    ints[:_HEADER] = (n, nq, nv, nl, ns, na)
+    ints = np.zeros(_int_size(n, nv, nl, na, ng, npairs), dtype=np.int64)
+    reals = np.zeros(_real_size(n, nq, nv, nl, ns, na, ng, npairs), dtype=np.float64)
+    ints[:_HEADER] = (n, nq, nv, nl, ns, na, ng, npairs, MAX_PAIR_CONTACTS * npairs)
     m = python_function(model_views)(ints, reals)
     m.world[GRAVITY : GRAVITY + 3], m.world[BASE_POS : BASE_POS + 3] = gravity, base_pos
     m.world[BASE_QUAT : BASE_QUAT + 4] = base_quat
@@ -296,6 +343,10 @@ def pack_model(links, loops, gravity, base_pos, base_quat, scalars=(), actuators
         m.scalar_q[s], m.scalar_v[s], m.scalar_reals[s] = q_coefficients, v_coefficients, columns
     for a, (scalar, columns) in enumerate(actuators):
         m.act_ints[a, 0], m.act_reals[a] = scalar, columns
+    for g, (int_columns, real_columns) in enumerate(geoms):
+        m.geom_ints[g], m.geom_reals[g] = int_columns, real_columns
+    for k, (int_columns, real_columns) in enumerate(pairs):
+        m.pair_ints[k], m.pair_reals[k] = int_columns, real_columns
     for k, loop in enumerate(loops):
         m.loop_ints[k] = (loop.link_a, -1 if loop.link_b is None else loop.link_b)
         m.loop_reals[k, POINT_A : POINT_A + 3] = loop.point_a

@@ -95,6 +95,9 @@ def from_articulation(articulation, gravity=None, *, parameters=None) -> System:
         if getattr(link, "limits", None) is not None or getattr(link, "frictionloss", 0.0) != 0.0:
             raise ValueError(f"link {_label(link)} has joint limits or frictionloss, constraints that the symbolic "
                              "derivation does not model")  # fmt: skip
+    if getattr(articulation, "geoms", ()):
+        raise ValueError(f"articulation has {len(articulation.geoms)} geoms: contacts are not part of the symbolic "
+                         "derivation")  # fmt: skip
     if getattr(articulation, "tendons", ()):
         raise ValueError(f"articulation has {len(articulation.tendons)} tendons, which the symbolic derivation does "
                          "not model yet")  # fmt: skip

@@ -12,11 +12,14 @@ in the model's order.
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 
 from ..articulation import Articulation, Ball, Fixed, Free, Prismatic, Revolute, SoftConstraint
 from ..rotation import quat_from_axis_angle, quat_multiply, quat_rotate
-from .description import JointDescription, ModelDescription
+from .description import GeomDescription, JointDescription, ModelDescription
+from .mjcf import MJCFWarning
 
 __all__ = ["to_articulation"]
 
@@ -45,6 +48,10 @@ def to_articulation(model: ModelDescription) -> Articulation:
     last_link: dict[int, tuple[int | None, np.ndarray]] = {-1: (None, np.zeros(3))}
     initial: list[tuple[int, float]] = []
     joint_links: dict[str, int] = {}
+    body_links: dict[int, int] = {}
+    skipped: dict[str, int] = {}
+    for geom in model.world_geoms:
+        _add_geom(art, None, geom, np.zeros(3), skipped)
     for index, body in enumerate(model.bodies):
         parent, parent_anchor = last_link[body.parent]
         joints = body.joints or (_WELD,)
@@ -72,8 +79,19 @@ def to_articulation(model: ModelDescription) -> Articulation:
             if joint.name is not None:
                 joint_links[joint.name] = parent
         last_link[index] = (parent, joints[-1].pos)
+        body_links[index] = parent
+        for geom in body.geoms:
+            _add_geom(art, parent, geom, joints[-1].pos, skipped)
     for link, ref in initial:
         art.set_joint(link, q=ref)
+    for first, second in model.excludes:
+        art.exclude_contacts(*(None if name == "world" else body_links[model.body_index(name)]
+                               for name in (first, second)))  # fmt: skip
+    art.impratio = model.impratio
+    if skipped:
+        warnings.warn(f"{model.source}: an articulation collides planes, spheres and capsules; "
+                      f"{', '.join(f'{n} {kind} geom(s)' for kind, n in sorted(skipped.items()))} do not touch "
+                      "anything (yet)", MJCFWarning, stacklevel=3)  # fmt: skip
     tendons = {}
     for tendon in model.tendons:
         tendons[tendon.name] = art.add_tendon(
@@ -93,6 +111,22 @@ def to_articulation(model: ModelDescription) -> Articulation:
 def _softness(settings) -> SoftConstraint | None:
     """MJCF's ``(solref, solimp)`` as a :class:`SoftConstraint` (``None``: MuJoCo's defaults)."""
     return None if settings is None else SoftConstraint(*settings)
+
+
+def _add_geom(art: Articulation, link: int | None, geom: GeomDescription, anchor: np.ndarray, skipped) -> None:
+    """Geom ``geom`` of a body on its link (whose frame is the body's moved to the joint's ``anchor``), as MuJoCo's
+    contact settings say; one that can touch nothing is left out, one of a type not collided counted in
+    ``skipped``."""
+    if geom.contype == 0 and geom.conaffinity == 0:
+        return
+    if geom.type not in ("plane", "sphere", "capsule") or (geom.type == "plane" and link is not None):
+        skipped[geom.type] = skipped.get(geom.type, 0) + 1
+        return
+    size = {"plane": (), "sphere": geom.size[:1], "capsule": geom.size[:2]}[geom.type]
+    art.add_geom(link, geom.type, size, position=geom.pos - anchor, orientation=geom.quat, contype=geom.contype,
+                 conaffinity=geom.conaffinity, condim=1 if geom.condim == 1 else 3, friction=float(geom.friction[0]),
+                 margin=geom.margin, softness=SoftConstraint(*geom.softness), solmix=geom.solmix,
+                 name=geom.name)  # fmt: skip
 
 
 def _spring(joint: JointDescription) -> float:

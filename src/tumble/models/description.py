@@ -76,6 +76,12 @@ class GeomDescription:
     friction: np.ndarray  # (3,) sliding, torsional, rolling
     line: int
     mesh: str | None = None  # a mesh geom's mesh (``ModelDescription.meshes``); a primitive fitted to one names it
+    # MuJoCo's contact settings: margin [m], condim, (solref, solimp), solmix, priority
+    margin: float = 0.0
+    condim: int = 3
+    softness: tuple[tuple[float, ...], tuple[float, ...]] = ((0.02, 1.0), (0.9, 0.95, 0.001, 0.5, 2.0))
+    solmix: float = 1.0
+    priority: int = 0
 
 
 @dataclass(frozen=True)
@@ -137,6 +143,8 @@ class ModelDescription:
     meshes: dict[str, MeshDescription] = field(default_factory=dict)
     actuators: tuple[ActuatorDescription, ...] = ()  # those tumble simulates, in the file's order
     tendons: tuple[TendonDescription, ...] = ()
+    excludes: tuple[tuple[str, str], ...] = ()  # <contact><exclude>: pairs of body names that do not touch
+    impratio: float = 1.0
 
     def body_index(self, name: str) -> int:
         for index, body in enumerate(self.bodies):

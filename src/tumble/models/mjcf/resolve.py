@@ -323,6 +323,9 @@ def _geom(reader: _Reader, node: Node, childclass: str) -> tuple[GeomDescription
         name=a.get("name"), type=kind, size=size, pos=pos, quat=quat, group=group,
         contype=int(_number(node, a, "contype", 1.0)), conaffinity=int(_number(node, a, "conaffinity", 1.0)),
         friction=_numbers(node, a, "friction", (1, 2, 3), [1.0, 0.005, 0.0001]), line=node.line, mesh=mesh,
+        margin=_number(node, a, "margin", 0.0, nonnegative=True), condim=_condim(node, a),
+        softness=softness(node, a, ""), solmix=_number(node, a, "solmix", 1.0, nonnegative=True),
+        priority=int(_number(node, a, "priority", 0.0)),
     )  # fmt: skip
     low, high = reader.compiler.inertiagrouprange
     if not low <= group <= high:
@@ -355,6 +358,25 @@ def _geom_mass(node: Node, a: dict[str, str], measure: float) -> float:
     if "mass" in a:
         return _number(node, a, "mass", 0.0, nonnegative=True)
     return _number(node, a, "density", 1000.0, nonnegative=True) * measure
+
+
+def _condim(node: Node, a: dict[str, str]) -> int:
+    value = _number(node, a, "condim", 3.0)
+    if value not in (1.0, 3.0, 4.0, 6.0):
+        raise node.error(f"condim={a.get('condim')!r} must be 1, 3, 4 or 6")
+    return int(value)
+
+
+def _read_contact(reader: _Reader, node: Node, excludes: list[tuple[str, str]]) -> None:
+    """``<contact>``: the ``<exclude>`` pairs; explicit ``<pair>`` elements are warned about."""
+    for child in node.children:
+        if child.tag == "exclude":
+            body1, body2 = child.attrib.get("body1"), child.attrib.get("body2")
+            if body1 is None or body2 is None:
+                raise child.error("an <exclude> names body1= and body2=")
+            excludes.append((body1, body2))
+        else:
+            reader.note(child, "element", "explicit contact pairs are not simulated by tumble (yet); ignored")
 
 
 def _inertial(reader: _Reader, node: Node) -> MassProperties:
@@ -536,7 +558,8 @@ def describe(root: Node, base: Path) -> ModelDescription:
     for node in root.children:  # assets before the bodies that use them, wherever the file writes them
         if node.tag == "asset":
             _read_assets(reader, node, base)
-    gravity, timestep, integrator = np.array([0.0, 0.0, -9.81]), 0.002, "Euler"
+    gravity, timestep, integrator, impratio = np.array([0.0, 0.0, -9.81]), 0.002, "Euler", 1.0
+    excludes: list[tuple[str, str]] = []
     bodies: list[BodyDescription] = []
     world_geoms: list[GeomDescription] = []
     for node in root.children:
@@ -550,6 +573,9 @@ def describe(root: Node, base: Path) -> ModelDescription:
                 raise node.error(f"timestep={node.attrib['timestep']!r} must be > 0")
             integrator = _keyword(node, node.attrib, "integrator", integrator,
                                   ("Euler", "RK4", "implicit", "implicitfast"))  # fmt: skip
+            impratio = _number(node, node.attrib, "impratio", impratio)
+            if impratio <= 0:
+                raise node.error(f"impratio={node.attrib['impratio']!r} must be > 0")
         elif node.tag == "worldbody":
             for child in node.children:
                 if child.tag == "body":
@@ -558,6 +584,8 @@ def describe(root: Node, base: Path) -> ModelDescription:
                     world_geoms.append(_geom(reader, child, "main")[0])
                 elif child.tag not in _SILENT:
                     reader.note(child, "element", "not supported by tumble; ignored")
+        elif node.tag == "contact":
+            _read_contact(reader, node, excludes)
         elif node.tag not in _SILENT and node.tag not in ("compiler", "default", "asset", "actuator", "tendon"):
             reader.note(node, "element", "not loaded by tumble (yet); ignored")
     tendons = _read_tendons(reader, root, bodies)
@@ -569,4 +597,5 @@ def describe(root: Node, base: Path) -> ModelDescription:
         name=root.attrib.get("model", "MuJoCo Model"), source=root.file, bodies=tuple(bodies),
         world_geoms=tuple(world_geoms), gravity=gravity, timestep=timestep, integrator=integrator,
         meshes={name: mesh for name, (mesh, _) in reader.meshes.items()}, actuators=actuators, tendons=tendons,
+        excludes=tuple(excludes), impratio=impratio,
     )  # fmt: skip

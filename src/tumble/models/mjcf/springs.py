@@ -25,7 +25,10 @@ def sized_springs(model: ModelDescription) -> ModelDescription:
         return model
     from ..build import to_articulation
 
-    articulation = to_articulation(model)  # it starts at qpos0
+    # its tree alone (it starts at qpos0): the mass matrix needs no geoms, tendons or actuators
+    tree = replace(model, bodies=tuple(replace(body, geoms=()) for body in model.bodies), world_geoms=(), tendons=(),
+                   actuators=(), excludes=())  # fmt: skip
+    articulation = to_articulation(tree)
     inverse = portable.inverse(articulation.mass_matrix(articulation.q))
     dof, bodies = 0, []
     for body in model.bodies:

@@ -30,8 +30,8 @@ _SOLIMP = (0.9, 0.95, 0.001, 0.5, 2.0)
 
 
 def softness(node: Node, a: dict[str, str], kind: str) -> tuple[tuple[float, ...], tuple[float, ...]]:
-    """``(solref, solimp)`` of a joint's or tendon's ``kind`` (``"limit"`` or ``"friction"``); an ``solimp`` may give
-    fewer than five numbers, the rest MuJoCo's defaults."""
+    """``(solref, solimp)`` of a joint's or tendon's ``kind`` (``"limit"`` or ``"friction"``), or a geom's (``""``);
+    an ``solimp`` may give fewer than five numbers, the rest MuJoCo's defaults."""
     solref = tuple(float(v) for v in numbers(node, a, f"solref{kind}", 2, list(_SOLREF)))
     given = numbers(node, a, f"solimp{kind}", (1, 2, 3, 4, 5), list(_SOLIMP))
     solimp = tuple(float(v) for v in given) + _SOLIMP[given.size :]
