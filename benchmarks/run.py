@@ -31,6 +31,9 @@ Run from the repository root:
                  compiler (``benchmarks/model_files.py``).
 ``mjcf_contacts`` Gymnasium's ant with contacts and its motors driven, in a tumble World and in MuJoCo at its 0.01 s
                  step (``benchmarks/model_files.py``).
+``robots``       Gymnasium's hopper, walker2d, half_cheetah, ant and humanoid as articulations with contacts at their
+                 own timesteps, in ``simulate`` and in a Python step loop that sets ``ctrl``, beside MuJoCo
+                 (``benchmarks/robots.py``).
 ``batch``        many copies at once: 4096 copies of a tumbling body and 1024 copies of a 10-box pile in a
                  ``tumble.Batch`` beside ``mujoco.rollout`` with the same copies and threads (``benchmarks/batch.py``).
 ``envs``         Gymnasium environments: tumble/CartPole and tumble/DoublePendulum beside InvertedPendulum-v5 and
@@ -84,6 +87,7 @@ from . import (
     model_files,
     peers,
     quadrotor,
+    robots,
 )
 
 __all__ = [
@@ -770,6 +774,9 @@ BENCHMARKS: dict[str, Callable[[Sizes], list[dict]]] = {
     ),
     "mjcf_contacts": lambda sizes: model_files.bench_mjcf_contacts(
         seconds=5.0 if sizes.repeat > 1 else 0.1, repeat=max(1, min(sizes.repeat, 3))
+    ),
+    "robots": lambda sizes: robots.bench_robots(
+        seconds=5.0 if sizes.repeat > 1 else 0.05, repeat=max(1, min(sizes.repeat, 5))
     ),
 }
 OPTIONAL = ("big_pyramid", "first_run")  # slow: run only when asked for with --only

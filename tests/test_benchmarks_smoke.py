@@ -305,6 +305,17 @@ def test_mjcf_contacts_rows_for_both_engines():
     assert {r["model"] for r in rows} == {"ant", "humanoid"}
 
 
+def test_robots_rows_for_both_engines_and_modes():
+    pytest.importorskip("mujoco")
+    pytest.importorskip("gymnasium")
+    from benchmarks import robots
+
+    rows = robots.bench_robots(seconds=0.02, repeat=1, models=("hopper",))
+    _assert_finite_numbers(rows)
+    assert {(r["engine"], r["mode"]) for r in rows} == {(e, m) for e in ("tumble", "MuJoCo")
+                                                         for m in ("simulate", "step loop")}  # fmt: skip
+
+
 def test_broad_phase_rows_for_both_worlds_and_pairs_in_the_pile():
     from benchmarks import broad_phase
 

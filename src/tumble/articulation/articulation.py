@@ -8,6 +8,7 @@ each joint's coordinates and ``docs/articulation.md`` for the whole layout.
 
 from __future__ import annotations
 
+import functools
 import numbers
 from dataclasses import dataclass, field
 from typing import NamedTuple
@@ -164,7 +165,16 @@ class _Compiled:
     no_record: np.ndarray
 
     def views(self):
-        """The named model and work arrays (views, for reading results after a kernel call)."""
+        """The named model and work arrays (views, for reading results after a kernel call; made once)."""
+        return self._views
+
+    def __getstate__(self):
+        state = dict(self.__dict__)
+        state.pop("_views", None)  # views of the buffers: a copy or a pickle makes them again from its own buffers
+        return state
+
+    @functools.cached_property
+    def _views(self):
         model = python_function(model_views)(self.ints, self.reals)
         return model, python_function(work_views)(self.work, *counts(self.ints))
 
@@ -204,6 +214,7 @@ class Articulation(JointDrives, Collisions):
         self._actuators: list[Actuator] = []
         self._ctrl = np.zeros(0)
         self._tendons: list[Tendon] = []
+        self._law = None  # the actuators' control law as arrays (drives.py)
         self._geoms: list[Geom] = []
         self._excluded: set[frozenset] = set()
         self._impratio = 1.0

@@ -15,8 +15,10 @@ The constraint forces solve MuJoCo's dual problem
     min_f  ½ fᵀ (A + R) f + fᵀ (J q̈₀ - aref),    A = J H⁻¹ Jᵀ,   f ≥ 0 (limits),  |f| ≤ frictionloss (friction),
 
 and ``q̈ = q̈₀ + H⁻¹ Jᵀ f``, ``q̈₀`` the acceleration without them. ``A + R`` is positive definite, so the solution is
-unique and projected Gauss–Seidel reaches it to rounding (the same solution MuJoCo's Newton, CG and PGS solvers
-converge to). ``τ`` is at least twice the step, as MuJoCo keeps it (``mjDSBL_REFSAFE`` off).
+unique (the one MuJoCo's Newton, CG and PGS solvers converge to). Projected Gauss–Seidel finds which rows rest on
+their bounds; every few sweeps the rows off their bounds are solved exactly by Cholesky, and once that solution
+keeps the KKT conditions the solve ends, at the solution to rounding. ``τ`` is at least twice the step, as MuJoCo
+keeps it (``mjDSBL_REFSAFE`` off).
 """
 
 from __future__ import annotations
@@ -31,10 +33,12 @@ from .model import (
     BIAS_SPEED,
     EFC_AREF,
     EFC_FORCE,
+    EFC_FREE,
     EFC_HIGH,
     EFC_LOW,
     EFC_OFFSET,
     EFC_R,
+    EFC_RHS,
     EFC_SCALAR,
     FORCE0,
     FORCE_HIGH,
@@ -62,6 +66,10 @@ _MIN_VALUE = 1e-15
 # projected Gauss-Seidel stops when no force moves by more than this fraction of the largest (or after the cap)
 _TOLERANCE = 1e-13
 _MAX_SWEEPS = 10000
+# every this many sweeps the active set the sweeps reached is tried by an exact solve, which ends the solve when the
+# KKT conditions hold to this fraction of the largest offset
+_POLISH_EVERY = 4
+_KKT_TOLERANCE = 1e-12
 
 
 @inline
@@ -73,7 +81,7 @@ def scalar_value(coefficients, s, x):
     return total
 
 
-@inline
+@inline(into_callers=True)
 def constrained(m):
     """Whether any scalar has a limit or dry friction, or geoms may touch (the model then solves constraints at
     every evaluation)."""
@@ -85,14 +93,21 @@ def constrained(m):
     return False
 
 
-@inline
+@inline(into_callers=True)
 def applied_forces(m, w, q, qd, tau):
     """The joint forces with the actuators' and the tendons' springs and dampers added: ``tau`` itself when the
     model has neither, else ``w.dof_work[APPLIED]``."""
-    scalar_reals, act_reals = m.scalar_reals, m.act_reals
-    if m.act_ints.shape[0] == 0 and scalar_reals.shape[0] == 0:
+    if m.act_ints.shape[0] == 0 and m.scalar_reals.shape[0] == 0:
         return tau
     out = w.dof_work[APPLIED]
+    _add_drives(m, q, qd, tau, out)
+    return out
+
+
+@inline(counted=False)
+def _add_drives(m, q, qd, tau, out):
+    """``out = tau`` plus the actuators' and tendons' forces."""
+    scalar_reals, act_reals = m.scalar_reals, m.act_reals
     for k in range(tau.shape[0]):
         out[k] = tau[k]
     for s in range(scalar_reals.shape[0]):
@@ -111,7 +126,6 @@ def applied_forces(m, w, q, qd, tau):
         force = min(max(force, act_reals[a, FORCE_LOW]), act_reals[a, FORCE_HIGH])
         for k in range(out.shape[0]):
             out[k] += gear * force * m.scalar_v[s, k]
-    return out
 
 
 @inline
@@ -176,7 +190,7 @@ def _scalar_row(m, w, count, s, sign, distance, kind, low, high, h, qd):
     return soft_row(w, count, s, distance, margin, row[kind : kind + 2], imps, row[INVWEIGHT], low, high, h, qd)
 
 
-@inline
+@inline(counted=False)
 def scalar_rows(m, w, q, qd, h):
     """The active rows of the scalars' limits and dry friction into ``w.efc_*``; returns their count."""
     scalar_reals = m.scalar_reals
@@ -196,6 +210,67 @@ def scalar_rows(m, w, q, qd, h):
 
 
 @inline
+def _solve_active_set(w, count):
+    """Solve the dual exactly with each row's force held where the sweeps left it: rows at a bound stay there, the
+    others solve ``(A + R)_FF f_F = -(offset_F + A_FB f_B)`` by Cholesky. Kept, and the solve done (True), when the
+    free forces stay inside their bounds and no bound row would rather leave its bound (the KKT conditions hold);
+    otherwise the sweeps go on from where they were (False)."""
+    e, matrix, factor = w.efc_work, w.efc_matrix, w.efc_factor
+    free = 0
+    for i in range(count):
+        if e[EFC_LOW, i] < e[EFC_FORCE, i] < e[EFC_HIGH, i]:
+            e[EFC_FREE, free] = i
+            free += 1
+    for a in range(free):
+        i = int(e[EFC_FREE, a])
+        rhs = -e[EFC_OFFSET, i]
+        for j in range(count):
+            if not e[EFC_LOW, j] < e[EFC_FORCE, j] < e[EFC_HIGH, j]:
+                rhs -= matrix[i, j] * e[EFC_FORCE, j]
+        e[EFC_RHS, a] = rhs
+        for b in range(a + 1):
+            total = matrix[i, int(e[EFC_FREE, b])] + (e[EFC_R, i] if a == b else 0.0)
+            for c in range(b):
+                total -= factor[a, c] * factor[b, c]
+            if a == b:
+                if not total > 0.0:
+                    return False
+                factor[a, a] = math.sqrt(total)
+            else:
+                factor[a, b] = total / factor[b, b]
+    for a in range(free):  # forward, then back substitution
+        total = e[EFC_RHS, a]
+        for c in range(a):
+            total -= factor[a, c] * e[EFC_RHS, c]
+        e[EFC_RHS, a] = total / factor[a, a]
+    for a in range(free - 1, -1, -1):
+        total = e[EFC_RHS, a]
+        for c in range(a + 1, free):
+            total -= factor[c, a] * e[EFC_RHS, c]
+        e[EFC_RHS, a] = total / factor[a, a]
+        i = int(e[EFC_FREE, a])
+        if not e[EFC_LOW, i] <= e[EFC_RHS, a] <= e[EFC_HIGH, i]:
+            return False
+    for a in range(free):
+        e[EFC_FORCE, int(e[EFC_FREE, a])] = e[EFC_RHS, a]
+    scale = 0.0
+    for i in range(count):
+        scale = max(scale, abs(e[EFC_OFFSET, i]))
+    for i in range(count):  # a row held at its bound must push against it
+        force = e[EFC_FORCE, i]
+        if e[EFC_LOW, i] < force < e[EFC_HIGH, i]:
+            continue
+        gradient = e[EFC_OFFSET, i] + e[EFC_R, i] * force
+        for j in range(count):
+            gradient += matrix[i, j] * e[EFC_FORCE, j]
+        if (force == e[EFC_LOW, i] and gradient < -_KKT_TOLERANCE * scale) or (
+            force == e[EFC_HIGH, i] and gradient > _KKT_TOLERANCE * scale
+        ):
+            return False
+    return True
+
+
+@inline(counted=False)
 def solve_constraints(m, w, count, factor, qdd):
     """Add the accelerations of the ``count`` active constraint rows in ``w.efc_*`` to ``qdd`` (which holds ``q̈₀``);
     ``factor``: ``H``'s LTDL factor (``dynamics.ltdl_factor``). The rows' forces stay in ``w.efc_work``."""
@@ -217,7 +292,7 @@ def solve_constraints(m, w, count, factor, qdd):
                 total += jac[i, k] * minv_jt[j, k]
             matrix[i, j] = total
             matrix[j, i] = total
-    for _ in range(_MAX_SWEEPS):  # projected Gauss-Seidel on the dual
+    for sweep in range(_MAX_SWEEPS):  # projected Gauss-Seidel on the dual, then an exact solve on its active set
         largest, change = 0.0, 0.0
         for i in range(count):
             residual = e[EFC_OFFSET, i] + e[EFC_R, i] * e[EFC_FORCE, i]
@@ -229,6 +304,8 @@ def solve_constraints(m, w, count, factor, qdd):
             change = max(change, abs(new - old))
             largest = max(largest, abs(new))
         if change <= _TOLERANCE * largest:
+            break
+        if sweep % _POLISH_EVERY == _POLISH_EVERY - 1 and _solve_active_set(w, count):
             break
     for i in range(count):
         force = e[EFC_FORCE, i]

@@ -131,7 +131,7 @@ def _closest_between_segments(p0, p1, q0, q1):
     return add(p0, scale(d1, s)), add(q0, scale(d2, t))
 
 
-@inline
+@inline(counted=False)
 def find_contacts(m, w):
     """The contacts of every pair at the link poses in ``w.link_work`` into ``w.contact_work``; returns their count."""
     contacts, link_work = w.contact_work, w.link_work
@@ -199,7 +199,7 @@ def _relative_jacobian(m, w, ga, gb, point, direction, row):
     _add_point_jacobian(m, w, m.geom_ints[ga, GEOM_LINK], point, direction, -1.0, row)
 
 
-@inline
+@inline(counted=False)
 def contact_rows(m, w, found, count, qd, h):
     """The constraint rows of the ``found`` contacts after the ``count`` rows already in ``w.efc_*``; returns the
     new count."""

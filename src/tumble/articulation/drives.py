@@ -30,8 +30,8 @@ def softness(name: str, value) -> SoftConstraint:
 
 class JointDrives:
     """Tendons and actuators. Expects of the class it is mixed into: ``_links``, ``_loops``, ``_q``, ``_qd``,
-    ``_tendons``, ``_actuators``, ``_ctrl``, ``_compiled`` (reset to ``None`` when the model changes), ``nv`` and
-    ``_check_link``, ``_check_q``, ``_check_vector``."""
+    ``_tendons``, ``_actuators``, ``_ctrl``, ``_law`` (None), ``_compiled`` (reset to ``None`` when the model
+    changes), ``nv`` and ``_check_link``, ``_check_q``, ``_check_vector``."""
 
     def add_tendon(self, links, coefficients, *, limits=None, margin=0.0, frictionloss=0.0, limit_softness=None,
                    friction_softness=None, stiffness=0.0, damping=0.0, springlength=None,
@@ -142,9 +142,17 @@ class JointDrives:
     def ctrl(self, value) -> None:
         self._ctrl = self._check_vector("ctrl", value, len(self._actuators))
         if self._compiled is not None:
-            act_reals = self._compiled.views()[0].act_reals
-            for actuator in self._actuators:
-                act_reals[actuator.index, FORCE0] = actuator.gain * actuator.control(self._ctrl) + actuator.bias[0]
+            # each actuator's gain · (control clipped to its range) + bias₀, as actuator_rows packs it
+            gain, bias, low, high = self._control_law()
+            self._compiled.views()[0].act_reals[:, FORCE0] = gain * np.minimum(np.maximum(self._ctrl, low), high) + bias
+
+    def _control_law(self):
+        """``(gain, bias₀, low, high)`` of every actuator, made once per set of actuators."""
+        if self._law is None or len(self._law[0]) != len(self._actuators):
+            ranges = [a.ctrl_range or (-math.inf, math.inf) for a in self._actuators]
+            self._law = (np.array([a.gain for a in self._actuators]), np.array([a.bias[0] for a in self._actuators]),
+                         np.array([r[0] for r in ranges]), np.array([r[1] for r in ranges]))  # fmt: skip
+        return self._law
 
     def actuator_forces(self, q=None, qd=None) -> np.ndarray:
         """Each actuator's force along its length at the state (default the current one), before its gear:

@@ -55,7 +55,7 @@ _BALL = int(JointType.BALL)
 _FREE = int(JointType.FREE)
 
 
-@inline
+@inline(counted=False)
 def accelerations(m, w, q, qd, tau, external, use_external, step_size):
     """``q̈`` into ``w.dof_work[QDD]`` for the state ``(q, qd)`` under joint forces ``tau`` (nv,).
 
@@ -146,7 +146,7 @@ def _first_bad_link(link_ints, q, qd):
     return -1
 
 
-@inline
+@inline(counted=False)
 def step(m, w, q, qd, tau, external, use_external, h, method):
     """Advance ``q``, ``qd`` in place by ``h`` seconds. Returns ``(status, where)``.
 

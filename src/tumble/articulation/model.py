@@ -92,7 +92,9 @@ LOOP_WORK_ROWS = 4
 # contact): the scalar (or -1 - contact), MuJoCo's reference acceleration and regulariser R, the force's bounds,
 # the force, and ``J q̈_smooth - aref``
 EFC_SCALAR, EFC_AREF, EFC_R, EFC_LOW, EFC_HIGH, EFC_FORCE, EFC_OFFSET = 0, 1, 2, 3, 4, 5, 6
-EFC_WORK_ROWS = 7
+# and the exact solve's: the rows off their bounds, and its right-hand side
+EFC_FREE, EFC_RHS = 7, 8
+EFC_WORK_ROWS = 9
 
 # ints[0:9] = link_count, q_count, v_count, loop_count, scalar_count, actuator_count, geom_count, pair_count and
 # the contacts the pairs can make at most
@@ -166,7 +168,8 @@ class Work(NamedTuple):
         energy: (2,) [J]: kinetic and potential.
         contact_work: (C, 11): the contacts found (the ``CONTACT_*`` columns), C the most the pairs can make.
         efc_jac: (rows, nv): the Jacobian of each active constraint row, rows = 3S + 4C; efc_minv_jt: (rows, nv):
-            ``H⁻¹ Jᵀ``; efc_matrix: (rows, rows): ``J H⁻¹ Jᵀ``; efc_work: (7, rows): the rows' data (``EFC_*``).
+            ``H⁻¹ Jᵀ``; efc_matrix: (rows, rows): ``J H⁻¹ Jᵀ``; efc_factor: (rows, rows): the exact solve's Cholesky
+            factor; efc_work: (9, rows): the rows' data (``EFC_*``).
     """
 
     link_work: np.ndarray
@@ -185,6 +188,7 @@ class Work(NamedTuple):
     efc_jac: np.ndarray
     efc_minv_jt: np.ndarray
     efc_matrix: np.ndarray
+    efc_factor: np.ndarray
     efc_work: np.ndarray
 
 
@@ -202,7 +206,7 @@ def work_size(n: int, nq: int, nv: int, loops: int, scalars: int, contacts: int)
     """The length of the work buffer that :func:`work_views` carves."""
     nc, nr = 3 * loops, 3 * scalars + 4 * contacts
     return (LINK_WORK_WIDTH * n + 12 * nv + nv * nv + DOF_WORK_ROWS * nv + 2 * nq + 2 * nc * nv + nc * nc + 4 * nc + 2
-            + CONTACT_WIDTH * contacts + 2 * nr * nv + nr * nr + EFC_WORK_ROWS * nr)  # fmt: skip
+            + CONTACT_WIDTH * contacts + 2 * nr * nv + 2 * nr * nr + EFC_WORK_ROWS * nr)  # fmt: skip
 
 
 @inline
@@ -285,9 +289,12 @@ def work_views(work, n, nq, nv, nl, ns, ncontacts):
     w += nr * nv
     efc_matrix = _rows(work, w, nr, nr)
     w += nr * nr
+    efc_factor = _rows(work, w, nr, nr)
+    w += nr * nr
     efc_work = _rows(work, w, EFC_WORK_ROWS, nr)
     return Work(link_work, dof_motion, dof_u, mass_matrix, dof_work, q_start, q_stage, loop_jac, loop_minv_jt,
-                loop_matrix, loop_work, energy, contact_work, efc_jac, efc_minv_jt, efc_matrix, efc_work)  # fmt: skip
+                loop_matrix, loop_work, energy, contact_work, efc_jac, efc_minv_jt, efc_matrix, efc_factor,
+                efc_work)  # fmt: skip
 
 
 def python_function(compiled):
