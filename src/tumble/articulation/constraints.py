@@ -16,9 +16,9 @@ The constraint forces solve MuJoCo's dual problem
 
 and ``q̈ = q̈₀ + H⁻¹ Jᵀ f``, ``q̈₀`` the acceleration without them. ``A + R`` is positive definite, so the solution is
 unique (the one MuJoCo's Newton, CG and PGS solvers converge to). Projected Gauss–Seidel finds which rows rest on
-their bounds; every few sweeps the rows off their bounds are solved exactly by Cholesky, and once that solution
-keeps the KKT conditions the solve ends, at the solution to rounding. ``τ`` is at least twice the step, as MuJoCo
-keeps it (``mjDSBL_REFSAFE`` off).
+their bounds; every other sweep block principal pivoting starts from that active set and solves exactly (the free
+rows by Cholesky), and once its solution keeps the KKT conditions the solve ends, at the solution to rounding. ``τ``
+is at least twice the step, as MuJoCo keeps it (``mjDSBL_REFSAFE`` off).
 """
 
 from __future__ import annotations
@@ -26,7 +26,7 @@ from __future__ import annotations
 import math
 
 from .._jit import inline
-from .dynamics import ltdl_solve
+from .dynamics import dl_solve, lt_solve
 from .model import (
     APPLIED,
     BIAS_LENGTH,
@@ -40,6 +40,8 @@ from .model import (
     EFC_R,
     EFC_RHS,
     EFC_SCALAR,
+    EFC_STATE,
+    EFC_TRIAL,
     FORCE0,
     FORCE_HIGH,
     FORCE_LOW,
@@ -53,6 +55,7 @@ from .model import (
     LIMITED,
     LOWER,
     MARGIN,
+    RHS,
     TENDON_DAMPING,
     TENDON_SPRINGLENGTH,
     TENDON_STIFFNESS,
@@ -68,8 +71,9 @@ _TOLERANCE = 1e-13
 _MAX_SWEEPS = 10000
 # every this many sweeps the active set the sweeps reached is tried by an exact solve, which ends the solve when the
 # KKT conditions hold to this fraction of the largest offset
-_POLISH_EVERY = 4
+_POLISH_EVERY = 2
 _KKT_TOLERANCE = 1e-12
+_PIVOT_ROUNDS = 8
 
 
 @inline
@@ -210,23 +214,30 @@ def scalar_rows(m, w, q, qd, h):
 
 
 @inline
-def _solve_active_set(w, count):
-    """Solve the dual exactly with each row's force held where the sweeps left it: rows at a bound stay there, the
-    others solve ``(A + R)_FF f_F = -(offset_F + A_FB f_B)`` by Cholesky. Kept, and the solve done (True), when the
-    free forces stay inside their bounds and no bound row would rather leave its bound (the KKT conditions hold);
-    otherwise the sweeps go on from where they were (False)."""
+def _bound_force(e, i):
+    """Row ``i``'s force for its state: its bound, or its trial force when free."""
+    state = e[EFC_STATE, i]
+    return e[EFC_LOW, i] if state < 0.0 else (e[EFC_HIGH, i] if state > 0.0 else e[EFC_TRIAL, i])
+
+
+@inline
+def _solve_free_rows(w, count):
+    """The trial forces of the free rows: ``(A + R)_FF f_F = -(offset_F + A_FB f_B)`` by Cholesky, the others at
+    their bounds. False when the system is not positive definite (rounding at a degenerate set)."""
     e, matrix, factor = w.efc_work, w.efc_matrix, w.efc_factor
     free = 0
     for i in range(count):
-        if e[EFC_LOW, i] < e[EFC_FORCE, i] < e[EFC_HIGH, i]:
+        if e[EFC_STATE, i] == 0.0:
             e[EFC_FREE, free] = i
             free += 1
+        else:
+            e[EFC_TRIAL, i] = _bound_force(e, i)
     for a in range(free):
         i = int(e[EFC_FREE, a])
         rhs = -e[EFC_OFFSET, i]
         for j in range(count):
-            if not e[EFC_LOW, j] < e[EFC_FORCE, j] < e[EFC_HIGH, j]:
-                rhs -= matrix[i, j] * e[EFC_FORCE, j]
+            if e[EFC_STATE, j] != 0.0:
+                rhs -= matrix[i, j] * e[EFC_TRIAL, j]
         e[EFC_RHS, a] = rhs
         for b in range(a + 1):
             total = matrix[i, int(e[EFC_FREE, b])] + (e[EFC_R, i] if a == b else 0.0)
@@ -248,26 +259,46 @@ def _solve_active_set(w, count):
         for c in range(a + 1, free):
             total -= factor[c, a] * e[EFC_RHS, c]
         e[EFC_RHS, a] = total / factor[a, a]
-        i = int(e[EFC_FREE, a])
-        if not e[EFC_LOW, i] <= e[EFC_RHS, a] <= e[EFC_HIGH, i]:
-            return False
-    for a in range(free):
-        e[EFC_FORCE, int(e[EFC_FREE, a])] = e[EFC_RHS, a]
+        e[EFC_TRIAL, int(e[EFC_FREE, a])] = e[EFC_RHS, a]
+    return True
+
+
+@inline
+def _solve_active_set(w, count):
+    """Solve the dual exactly by block principal pivoting (Júdice and Pires, 1994) from the active set the sweeps
+    reached: solve the free rows with the others at their bounds, then bound each free row that left its box and free
+    each bound row that would rather leave its bound, until nothing changes (the KKT conditions hold: the solution,
+    kept in ``EFC_FORCE``, True) or a few rounds pass (False: the sweeps go on from where they were)."""
+    e, matrix = w.efc_work, w.efc_matrix
     scale = 0.0
     for i in range(count):
-        scale = max(scale, abs(e[EFC_OFFSET, i]))
-    for i in range(count):  # a row held at its bound must push against it
         force = e[EFC_FORCE, i]
-        if e[EFC_LOW, i] < force < e[EFC_HIGH, i]:
-            continue
-        gradient = e[EFC_OFFSET, i] + e[EFC_R, i] * force
-        for j in range(count):
-            gradient += matrix[i, j] * e[EFC_FORCE, j]
-        if (force == e[EFC_LOW, i] and gradient < -_KKT_TOLERANCE * scale) or (
-            force == e[EFC_HIGH, i] and gradient > _KKT_TOLERANCE * scale
-        ):
+        e[EFC_STATE, i] = -1.0 if force <= e[EFC_LOW, i] else (1.0 if force >= e[EFC_HIGH, i] else 0.0)
+        scale = max(scale, abs(e[EFC_OFFSET, i]))
+    for _ in range(_PIVOT_ROUNDS):
+        if not _solve_free_rows(w, count):
             return False
-    return True
+        changed = False
+        for i in range(count):
+            state, trial = e[EFC_STATE, i], e[EFC_TRIAL, i]
+            if state == 0.0:
+                if trial < e[EFC_LOW, i]:
+                    e[EFC_STATE, i], changed = -1.0, True
+                elif trial > e[EFC_HIGH, i]:
+                    e[EFC_STATE, i], changed = 1.0, True
+                continue
+            gradient = e[EFC_OFFSET, i] + e[EFC_R, i] * trial
+            for j in range(count):
+                gradient += matrix[i, j] * e[EFC_TRIAL, j]
+            if (state < 0.0 and gradient < -_KKT_TOLERANCE * scale) or (
+                state > 0.0 and gradient > _KKT_TOLERANCE * scale
+            ):
+                e[EFC_STATE, i], changed = 0.0, True
+        if not changed:
+            for i in range(count):
+                e[EFC_FORCE, i] = e[EFC_TRIAL, i]
+            return True
+    return False
 
 
 @inline(counted=False)
@@ -276,20 +307,23 @@ def solve_constraints(m, w, count, factor, qdd):
     ``factor``: ``H``'s LTDL factor (``dynamics.ltdl_factor``). The rows' forces stay in ``w.efc_work``."""
     if count == 0:
         return
-    e, jac, minv_jt, matrix, nv = w.efc_work, w.efc_jac, w.efc_minv_jt, w.efc_matrix, qdd.shape[0]
-    for i in range(count):  # H⁻¹ Jᵢᵀ, then A = J H⁻¹ Jᵀ and the offsets J q̈₀ - aref
-        for k in range(nv):
-            minv_jt[i, k] = jac[i, k]
-        ltdl_solve(m.dof_ints, factor, minv_jt[i])
+    # A = J H⁻¹ Jᵀ = Yᵀ D⁻¹ Y with Y = L⁻ᵀ Jᵀ (H = Lᵀ D L): one sparse half-solve a row (Featherstone 2008, §6.5)
+    e, jac, half, matrix, nv = w.efc_work, w.efc_jac, w.efc_minv_jt, w.efc_matrix, qdd.shape[0]
+    for i in range(count):
         offset = 0.0
         for k in range(nv):
+            half[i, k] = jac[i, k]
             offset += jac[i, k] * qdd[k]
+        lt_solve(m.dof_ints, factor, half[i])
         e[EFC_OFFSET, i] = offset - e[EFC_AREF, i]
+    inverse_pivots = w.dof_work[RHS]
+    for k in range(nv):
+        inverse_pivots[k] = 1.0 / factor[k, k]
     for i in range(count):
         for j in range(i, count):
             total = 0.0
             for k in range(nv):
-                total += jac[i, k] * minv_jt[j, k]
+                total += half[i, k] * half[j, k] * inverse_pivots[k]
             matrix[i, j] = total
             matrix[j, i] = total
     for sweep in range(_MAX_SWEEPS):  # projected Gauss-Seidel on the dual, then an exact solve on its active set
@@ -307,7 +341,13 @@ def solve_constraints(m, w, count, factor, qdd):
             break
         if sweep % _POLISH_EVERY == _POLISH_EVERY - 1 and _solve_active_set(w, count):
             break
+    correction = w.dof_work[RHS]  # H⁻¹ Jᵀ f = L⁻¹ D⁻¹ (Σ fᵢ Yᵢ)
+    for k in range(nv):
+        correction[k] = 0.0
     for i in range(count):
         force = e[EFC_FORCE, i]
         for k in range(nv):
-            qdd[k] += force * minv_jt[i, k]
+            correction[k] += force * half[i, k]
+    dl_solve(m.dof_ints, factor, correction)
+    for k in range(nv):
+        qdd[k] += correction[k]

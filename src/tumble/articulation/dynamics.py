@@ -54,7 +54,7 @@ from .spatial import (
     vec3,
 )
 
-__all__ = ["crba", "ltdl_factor", "ltdl_solve", "rnea"]
+__all__ = ["crba", "dl_solve", "lt_solve", "ltdl_factor", "ltdl_solve", "rnea"]
 
 # A pivot below this fraction of the largest diagonal entry means a degree of freedom moves no mass:
 # float64 rounding leaves ~1e-16 relative, a real model's lightest link is far above 1e-12.
@@ -196,12 +196,28 @@ def ltdl_factor(dof_ints, h, diag):
 @inline
 def ltdl_solve(dof_ints, h, x):
     """Solve ``Lᵀ D L x = b`` in place (``x`` holds ``b`` on entry), ``h`` from :func:`ltdl_factor` (Table 6.4)."""
+    lt_solve(dof_ints, h, x)
+    dl_solve(dof_ints, h, x)
+
+
+@inline
+def lt_solve(dof_ints, h, x):
+    """The first half of :func:`ltdl_solve`: ``x ← L⁻ᵀ x``. Only the ancestors of ``x``'s non-zero entries become
+    non-zero, so a sparse ``x`` (a constraint's Jacobian) stays sparse."""
     nv = h.shape[0]
     for i in range(nv - 1, -1, -1):
+        if x[i] == 0.0:
+            continue
         j = dof_ints[i, DOF_PARENT]
         while j >= 0:
             x[j] -= h[i, j] * x[i]
             j = dof_ints[j, DOF_PARENT]
+
+
+@inline
+def dl_solve(dof_ints, h, x):
+    """The second half of :func:`ltdl_solve`: ``x ← L⁻¹ D⁻¹ x``."""
+    nv = h.shape[0]
     for i in range(nv):
         x[i] /= h[i, i]
     for i in range(nv):

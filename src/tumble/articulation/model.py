@@ -92,9 +92,10 @@ LOOP_WORK_ROWS = 4
 # contact): the scalar (or -1 - contact), MuJoCo's reference acceleration and regulariser R, the force's bounds,
 # the force, and ``J q̈_smooth - aref``
 EFC_SCALAR, EFC_AREF, EFC_R, EFC_LOW, EFC_HIGH, EFC_FORCE, EFC_OFFSET = 0, 1, 2, 3, 4, 5, 6
-# and the exact solve's: the rows off their bounds, and its right-hand side
-EFC_FREE, EFC_RHS = 7, 8
-EFC_WORK_ROWS = 9
+# and the exact solve's: the rows off their bounds, its right-hand side, each row's state (0 free, -1 at its lower
+# bound, 1 at its upper) and force
+EFC_FREE, EFC_RHS, EFC_STATE, EFC_TRIAL = 7, 8, 9, 10
+EFC_WORK_ROWS = 11
 
 # ints[0:9] = link_count, q_count, v_count, loop_count, scalar_count, actuator_count, geom_count, pair_count and
 # the contacts the pairs can make at most
@@ -169,7 +170,7 @@ class Work(NamedTuple):
         contact_work: (C, 11): the contacts found (the ``CONTACT_*`` columns), C the most the pairs can make.
         efc_jac: (rows, nv): the Jacobian of each active constraint row, rows = 3S + 4C; efc_minv_jt: (rows, nv):
             ``H⁻¹ Jᵀ``; efc_matrix: (rows, rows): ``J H⁻¹ Jᵀ``; efc_factor: (rows, rows): the exact solve's Cholesky
-            factor; efc_work: (9, rows): the rows' data (``EFC_*``).
+            factor; efc_work: (11, rows): the rows' data (``EFC_*``).
     """
 
     link_work: np.ndarray
