@@ -10,15 +10,9 @@ solves them (MuJoCo documentation, *Computation*: "Soft constraints" and "Solver
 impedance ``d(r)`` of its ``solimp``, the stiffness and damping ``k = 1/(d_max² τ² ζ²)``, ``b = 2/(d_max τ)`` of its
 ``solref = (τ, ζ)`` (or ``k = -solref₀/d_max²``, ``b = -solref₁/d_max`` when negative), the reference acceleration
 ``aref = -b J q̇ - k d (r - margin)`` (``k = 0`` for friction) and the regulariser ``R = (1 - d)/d · invweight0``.
-The constraint forces solve MuJoCo's dual problem
-
-    min_f  ½ fᵀ (A + R) f + fᵀ (J q̈₀ - aref),    A = J H⁻¹ Jᵀ,   f ≥ 0 (limits),  |f| ≤ frictionloss (friction),
-
-and ``q̈ = q̈₀ + H⁻¹ Jᵀ f``, ``q̈₀`` the acceleration without them. ``A + R`` is positive definite, so the solution is
-unique (the one MuJoCo's Newton, CG and PGS solvers converge to). Projected Gauss–Seidel finds which rows rest on
-their bounds; every other sweep block principal pivoting starts from that active set and solves exactly (the free
-rows by Cholesky), and once its solution keeps the KKT conditions the solve ends, at the solution to rounding. ``τ``
-is at least twice the step, as MuJoCo keeps it (``mjDSBL_REFSAFE`` off).
+The constraint forces solve MuJoCo's dual problem with them (``dual_solver.py``): limits push only (``f ≥ 0``), dry
+friction is boxed (``|f| ≤ frictionloss``). ``τ`` is at least twice the step, as MuJoCo keeps it
+(``mjDSBL_REFSAFE`` off).
 """
 
 from __future__ import annotations
@@ -26,22 +20,16 @@ from __future__ import annotations
 import math
 
 from .._jit import inline
-from .dynamics import dl_solve, lt_solve
 from .model import (
     APPLIED,
     BIAS_LENGTH,
     BIAS_SPEED,
     EFC_AREF,
     EFC_FORCE,
-    EFC_FREE,
     EFC_HIGH,
     EFC_LOW,
-    EFC_OFFSET,
     EFC_R,
-    EFC_RHS,
     EFC_SCALAR,
-    EFC_STATE,
-    EFC_TRIAL,
     FORCE0,
     FORCE_HIGH,
     FORCE_LOW,
@@ -55,25 +43,16 @@ from .model import (
     LIMITED,
     LOWER,
     MARGIN,
-    RHS,
     TENDON_DAMPING,
     TENDON_SPRINGLENGTH,
     TENDON_STIFFNESS,
     UPPER,
 )
 
-__all__ = ["applied_forces", "constrained", "impedance", "scalar_rows", "scalar_value", "soft_row", "solve_constraints"]
+__all__ = ["applied_forces", "constrained", "impedance", "scalar_rows", "scalar_value", "soft_row"]
 
 # MuJoCo's mjMINVAL: the smallest regulariser
 _MIN_VALUE = 1e-15
-# projected Gauss-Seidel stops when no force moves by more than this fraction of the largest (or after the cap)
-_TOLERANCE = 1e-13
-_MAX_SWEEPS = 10000
-# every this many sweeps the active set the sweeps reached is tried by an exact solve, which ends the solve when the
-# KKT conditions hold to this fraction of the largest offset
-_POLISH_EVERY = 2
-_KKT_TOLERANCE = 1e-12
-_PIVOT_ROUNDS = 8
 
 
 @inline
@@ -211,143 +190,3 @@ def scalar_rows(m, w, q, qd, h):
             if row[UPPER] - length < margin:
                 count = _scalar_row(m, w, count, s, -1.0, row[UPPER] - length, LIMIT_SOLREF, 0.0, math.inf, h, qd)
     return count
-
-
-@inline
-def _bound_force(e, i):
-    """Row ``i``'s force for its state: its bound, or its trial force when free."""
-    state = e[EFC_STATE, i]
-    return e[EFC_LOW, i] if state < 0.0 else (e[EFC_HIGH, i] if state > 0.0 else e[EFC_TRIAL, i])
-
-
-@inline
-def _solve_free_rows(w, count):
-    """The trial forces of the free rows: ``(A + R)_FF f_F = -(offset_F + A_FB f_B)`` by Cholesky, the others at
-    their bounds. False when the system is not positive definite (rounding at a degenerate set)."""
-    e, matrix, factor = w.efc_work, w.efc_matrix, w.efc_factor
-    free = 0
-    for i in range(count):
-        if e[EFC_STATE, i] == 0.0:
-            e[EFC_FREE, free] = i
-            free += 1
-        else:
-            e[EFC_TRIAL, i] = _bound_force(e, i)
-    for a in range(free):
-        i = int(e[EFC_FREE, a])
-        rhs = -e[EFC_OFFSET, i]
-        for j in range(count):
-            if e[EFC_STATE, j] != 0.0:
-                rhs -= matrix[i, j] * e[EFC_TRIAL, j]
-        e[EFC_RHS, a] = rhs
-        for b in range(a + 1):
-            total = matrix[i, int(e[EFC_FREE, b])] + (e[EFC_R, i] if a == b else 0.0)
-            for c in range(b):
-                total -= factor[a, c] * factor[b, c]
-            if a == b:
-                if not total > 0.0:
-                    return False
-                factor[a, a] = math.sqrt(total)
-            else:
-                factor[a, b] = total / factor[b, b]
-    for a in range(free):  # forward, then back substitution
-        total = e[EFC_RHS, a]
-        for c in range(a):
-            total -= factor[a, c] * e[EFC_RHS, c]
-        e[EFC_RHS, a] = total / factor[a, a]
-    for a in range(free - 1, -1, -1):
-        total = e[EFC_RHS, a]
-        for c in range(a + 1, free):
-            total -= factor[c, a] * e[EFC_RHS, c]
-        e[EFC_RHS, a] = total / factor[a, a]
-        e[EFC_TRIAL, int(e[EFC_FREE, a])] = e[EFC_RHS, a]
-    return True
-
-
-@inline
-def _solve_active_set(w, count):
-    """Solve the dual exactly by block principal pivoting (Júdice and Pires, 1994) from the active set the sweeps
-    reached: solve the free rows with the others at their bounds, then bound each free row that left its box and free
-    each bound row that would rather leave its bound, until nothing changes (the KKT conditions hold: the solution,
-    kept in ``EFC_FORCE``, True) or a few rounds pass (False: the sweeps go on from where they were)."""
-    e, matrix = w.efc_work, w.efc_matrix
-    scale = 0.0
-    for i in range(count):
-        force = e[EFC_FORCE, i]
-        e[EFC_STATE, i] = -1.0 if force <= e[EFC_LOW, i] else (1.0 if force >= e[EFC_HIGH, i] else 0.0)
-        scale = max(scale, abs(e[EFC_OFFSET, i]))
-    for _ in range(_PIVOT_ROUNDS):
-        if not _solve_free_rows(w, count):
-            return False
-        changed = False
-        for i in range(count):
-            state, trial = e[EFC_STATE, i], e[EFC_TRIAL, i]
-            if state == 0.0:
-                if trial < e[EFC_LOW, i]:
-                    e[EFC_STATE, i], changed = -1.0, True
-                elif trial > e[EFC_HIGH, i]:
-                    e[EFC_STATE, i], changed = 1.0, True
-                continue
-            gradient = e[EFC_OFFSET, i] + e[EFC_R, i] * trial
-            for j in range(count):
-                gradient += matrix[i, j] * e[EFC_TRIAL, j]
-            if (state < 0.0 and gradient < -_KKT_TOLERANCE * scale) or (
-                state > 0.0 and gradient > _KKT_TOLERANCE * scale
-            ):
-                e[EFC_STATE, i], changed = 0.0, True
-        if not changed:
-            for i in range(count):
-                e[EFC_FORCE, i] = e[EFC_TRIAL, i]
-            return True
-    return False
-
-
-@inline(counted=False)
-def solve_constraints(m, w, count, factor, qdd):
-    """Add the accelerations of the ``count`` active constraint rows in ``w.efc_*`` to ``qdd`` (which holds ``q̈₀``);
-    ``factor``: ``H``'s LTDL factor (``dynamics.ltdl_factor``). The rows' forces stay in ``w.efc_work``."""
-    if count == 0:
-        return
-    # A = J H⁻¹ Jᵀ = Yᵀ D⁻¹ Y with Y = L⁻ᵀ Jᵀ (H = Lᵀ D L): one sparse half-solve a row (Featherstone 2008, §6.5)
-    e, jac, half, matrix, nv = w.efc_work, w.efc_jac, w.efc_minv_jt, w.efc_matrix, qdd.shape[0]
-    for i in range(count):
-        offset = 0.0
-        for k in range(nv):
-            half[i, k] = jac[i, k]
-            offset += jac[i, k] * qdd[k]
-        lt_solve(m.dof_ints, factor, half[i])
-        e[EFC_OFFSET, i] = offset - e[EFC_AREF, i]
-    inverse_pivots = w.dof_work[RHS]
-    for k in range(nv):
-        inverse_pivots[k] = 1.0 / factor[k, k]
-    for i in range(count):
-        for j in range(i, count):
-            total = 0.0
-            for k in range(nv):
-                total += half[i, k] * half[j, k] * inverse_pivots[k]
-            matrix[i, j] = total
-            matrix[j, i] = total
-    for sweep in range(_MAX_SWEEPS):  # projected Gauss-Seidel on the dual, then an exact solve on its active set
-        largest, change = 0.0, 0.0
-        for i in range(count):
-            residual = e[EFC_OFFSET, i] + e[EFC_R, i] * e[EFC_FORCE, i]
-            for j in range(count):
-                residual += matrix[i, j] * e[EFC_FORCE, j]
-            old = e[EFC_FORCE, i]
-            new = min(max(old - residual / (matrix[i, i] + e[EFC_R, i]), e[EFC_LOW, i]), e[EFC_HIGH, i])
-            e[EFC_FORCE, i] = new
-            change = max(change, abs(new - old))
-            largest = max(largest, abs(new))
-        if change <= _TOLERANCE * largest:
-            break
-        if sweep % _POLISH_EVERY == _POLISH_EVERY - 1 and _solve_active_set(w, count):
-            break
-    correction = w.dof_work[RHS]  # H⁻¹ Jᵀ f = L⁻¹ D⁻¹ (Σ fᵢ Yᵢ)
-    for k in range(nv):
-        correction[k] = 0.0
-    for i in range(count):
-        force = e[EFC_FORCE, i]
-        for k in range(nv):
-            correction[k] += force * half[i, k]
-    dl_solve(m.dof_ints, factor, correction)
-    for k in range(nv):
-        qdd[k] += correction[k]

@@ -25,8 +25,9 @@ import math
 from .._jit import inline
 from ..math3d import add, add_scaled, cross, scale
 from .aba import aba
-from .constraints import applied_forces, constrained, scalar_rows, solve_constraints
+from .constraints import applied_forces, constrained, scalar_rows
 from .contacts import contact_rows, find_contacts
+from .dual_solver import solve_constraints
 from .dynamics import crba, ltdl_factor, ltdl_solve, rnea
 from .joints import JointType
 from .kinematics import forward_kinematics, integrate_configuration

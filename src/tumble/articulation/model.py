@@ -92,10 +92,10 @@ LOOP_WORK_ROWS = 4
 # contact): the scalar (or -1 - contact), MuJoCo's reference acceleration and regulariser R, the force's bounds,
 # the force, and ``J q̈_smooth - aref``
 EFC_SCALAR, EFC_AREF, EFC_R, EFC_LOW, EFC_HIGH, EFC_FORCE, EFC_OFFSET = 0, 1, 2, 3, 4, 5, 6
-# and the exact solve's: the rows off their bounds, its right-hand side, each row's state (0 free, -1 at its lower
-# bound, 1 at its upper) and force
-EFC_FREE, EFC_RHS, EFC_STATE, EFC_TRIAL = 7, 8, 9, 10
-EFC_WORK_ROWS = 11
+# and the solver's (dual_solver.py): the diagonal of J H⁻¹ Jᵀ, and the pivoting's state of each row (0 free, -1 at
+# its lower bound, 1 at its upper) and its force
+EFC_DIAG, EFC_STATE, EFC_TRIAL = 7, 8, 9
+EFC_WORK_ROWS = 10
 
 # ints[0:9] = link_count, q_count, v_count, loop_count, scalar_count, actuator_count, geom_count, pair_count and
 # the contacts the pairs can make at most
@@ -169,8 +169,8 @@ class Work(NamedTuple):
         energy: (2,) [J]: kinetic and potential.
         contact_work: (C, 11): the contacts found (the ``CONTACT_*`` columns), C the most the pairs can make.
         efc_jac: (rows, nv): the Jacobian of each active constraint row, rows = 3S + 4C; efc_minv_jt: (rows, nv):
-            ``H⁻¹ Jᵀ``; efc_matrix: (rows, rows): ``J H⁻¹ Jᵀ``; efc_factor: (rows, rows): the exact solve's Cholesky
-            factor; efc_work: (11, rows): the rows' data (``EFC_*``).
+            ``L⁻ᵀ Jᵀ`` (``H = Lᵀ D L``); efc_factor: (nv, nv): the pivoting's Cholesky factor; efc_z: (nv,): ``Σ fᵢ
+            L⁻ᵀ Jᵢᵀ``; efc_inverse_pivots: (nv,): ``D⁻¹``; efc_work: (10, rows): the rows' data (``EFC_*``).
     """
 
     link_work: np.ndarray
@@ -188,8 +188,9 @@ class Work(NamedTuple):
     contact_work: np.ndarray
     efc_jac: np.ndarray
     efc_minv_jt: np.ndarray
-    efc_matrix: np.ndarray
     efc_factor: np.ndarray
+    efc_z: np.ndarray
+    efc_inverse_pivots: np.ndarray
     efc_work: np.ndarray
 
 
@@ -207,7 +208,7 @@ def work_size(n: int, nq: int, nv: int, loops: int, scalars: int, contacts: int)
     """The length of the work buffer that :func:`work_views` carves."""
     nc, nr = 3 * loops, 3 * scalars + 4 * contacts
     return (LINK_WORK_WIDTH * n + 12 * nv + nv * nv + DOF_WORK_ROWS * nv + 2 * nq + 2 * nc * nv + nc * nc + 4 * nc + 2
-            + CONTACT_WIDTH * contacts + 2 * nr * nv + 2 * nr * nr + EFC_WORK_ROWS * nr)  # fmt: skip
+            + CONTACT_WIDTH * contacts + 2 * nr * nv + nv * nv + 2 * nv + EFC_WORK_ROWS * nr)  # fmt: skip
 
 
 @inline
@@ -288,14 +289,14 @@ def work_views(work, n, nq, nv, nl, ns, ncontacts):
     w += nr * nv
     efc_minv_jt = _rows(work, w, nr, nv)
     w += nr * nv
-    efc_matrix = _rows(work, w, nr, nr)
-    w += nr * nr
-    efc_factor = _rows(work, w, nr, nr)
-    w += nr * nr
+    efc_factor = _rows(work, w, nv, nv)
+    w += nv * nv
+    efc_z, efc_inverse_pivots = work[w : w + nv], work[w + nv : w + 2 * nv]
+    w += 2 * nv
     efc_work = _rows(work, w, EFC_WORK_ROWS, nr)
     return Work(link_work, dof_motion, dof_u, mass_matrix, dof_work, q_start, q_stage, loop_jac, loop_minv_jt,
-                loop_matrix, loop_work, energy, contact_work, efc_jac, efc_minv_jt, efc_matrix, efc_factor,
-                efc_work)  # fmt: skip
+                loop_matrix, loop_work, energy, contact_work, efc_jac, efc_minv_jt, efc_factor, efc_z,
+                efc_inverse_pivots, efc_work)  # fmt: skip
 
 
 def python_function(compiled):
