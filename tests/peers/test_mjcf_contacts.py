@@ -159,6 +159,11 @@ def test_the_locomotion_models_come_to_rest_where_mujocos_do(name):
     assert np.max(np.abs(ours - theirs)) < 0.01
     assert np.max(np.abs(ours - theirs)) < REST[name]
     assert np.max(np.abs(art.qd - data.qvel)) < 1e-3  # as still as MuJoCo's (the walker still sways by 6 mrad/s)
+    scalar = (mujoco.mjtJoint.mjJNT_HINGE, mujoco.mjtJoint.mjJNT_SLIDE)
+    for j in (j for j in range(model.njnt) if model.jnt_type[j] in scalar):  # each joint by its name
+        joint, theirs = art.joint(model.joint(j).name), data.joint(j)
+        ours = joint.angle if model.jnt_type[j] == mujoco.mjtJoint.mjJNT_HINGE else joint.translation
+        assert ours == pytest.approx(theirs.qpos[0], abs=0.01)
 
 
 def test_the_humanoid_falls_and_lies_with_no_shapes_overlapping_by_more_than_5_mm():

@@ -441,3 +441,26 @@ def test_geoms_and_loop_closures_are_not_simulated_together():
     with pytest.raises(ValueError, match="contacts are not simulated with loop closures"):
         looped.add_geom(0, "sphere", (0.1,))
     assert looped.geoms == ()
+
+
+def test_joints_by_name_read_and_set_their_coordinates():
+    art = Articulation()
+    hinge = art.add_link(Revolute((0, 1, 0)), mass=1.0, shape_position=(0, 0, -1), joint_name="hip")
+    art.add_link(Prismatic((0, 0, 1)), parent=hinge, mass=1.0, joint_name="slide")
+    art.add_link(Ball(), parent=hinge, mass=1.0, shape_position=(0, 0, -1), joint_name="wrist")
+    hip, slide, wrist = art.joint("hip"), art.joint("slide"), art.joint("wrist")
+    hip.angle, hip.angular_speed, slide.translation, slide.speed = 0.4, -1.0, 0.2, 3.0
+    np.testing.assert_array_equal(art.q[:2], [0.4, 0.2])
+    np.testing.assert_array_equal(art.qd[:2], [-1.0, 3.0])
+    assert (hip.angle, hip.angular_speed, slide.translation, slide.speed) == (0.4, -1.0, 0.2, 3.0)
+    np.testing.assert_array_equal(wrist.q, [1.0, 0.0, 0.0, 0.0])
+    with pytest.raises(AttributeError, match=r"joint 'hip' is a Revolute.*translation belongs to a Prismatic joint"):
+        hip.translation  # noqa: B018
+    with pytest.raises(AttributeError, match=r"joint 'wrist' is a Ball\(\): angle belongs to a Revolute joint"):
+        wrist.angle = 0.1
+    with pytest.raises(KeyError, match=r"no joint named 'knee'; names: \['hip', 'slide', 'wrist'\]"):
+        art.joint("knee")
+    with pytest.raises(ValueError, match=r"joint_name must be unique, got 'hip'"):
+        art.add_link(Revolute((1, 0, 0)), parent=hinge, mass=1.0, joint_name="hip")
+    with pytest.raises(TypeError, match=r"joint_name must be a string or None, got 3"):
+        art.add_link(Revolute((1, 0, 0)), parent=hinge, mass=1.0, joint_name=3)

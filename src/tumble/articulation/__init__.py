@@ -18,6 +18,7 @@ from .actuators import Actuator
 from .articulation import Articulation, ArticulationContacts, ArticulationTrajectory, Link
 from .batch import ArticulationBatch
 from .collision import Geom
+from .joint_view import ArticulationJoint
 from .joints import Ball, Fixed, Free, Joint, JointType, Prismatic, Revolute
 from .limits import SoftConstraint, Tendon
 from .loops import LoopClosure
@@ -54,6 +55,7 @@ __all__ = [
     "Articulation",
     "ArticulationBatch",
     "ArticulationContacts",
+    "ArticulationJoint",
     "ArticulationTrajectory",
     "Ball",
     "Fixed",

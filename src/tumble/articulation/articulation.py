@@ -36,6 +36,7 @@ from .actuators import Actuator
 from .collision import Collisions, Geom, geom_rows, pair_rows, pair_weights, translation_weight
 from .drives import JointDrives, softness
 from .integrators import EULER, NOT_FINITE, RK4, SYMPLECTIC
+from .joint_view import ArticulationJoint
 from .joints import Ball, Free, Joint, Prismatic, Revolute
 from .kernels import CONTACTS, FORWARD, INVERSE, KINEMATICS, MASS_MATRIX, PROJECT, SIMULATE, articulation_kernel
 from .limits import SoftConstraint, Tendon, actuator_rows, check_limits, invweights, readonly, scalar_rows
@@ -93,6 +94,7 @@ class Link:
         limits: ``(lower, upper)`` of a revolute or prismatic joint's coordinate, or ``None``; margin: the distance
             from a limit at which it starts to act; frictionloss: the dry friction on each degree of freedom;
             limit_softness, friction_softness: their :class:`SoftConstraint` (MuJoCo's ``solref``/``solimp``).
+        joint_name: the joint's own name (``Articulation.joint``), or ``None``.
     """
 
     index: int
@@ -116,6 +118,7 @@ class Link:
     frictionloss: float = 0.0
     limit_softness: SoftConstraint = field(default_factory=SoftConstraint)
     friction_softness: SoftConstraint = field(default_factory=SoftConstraint)
+    joint_name: str | None = None
 
 
 class ArticulationContacts(NamedTuple):
@@ -225,7 +228,7 @@ class Articulation(JointDrives, Collisions):
                  shape=None, mass=None, density=None, mass_properties=None, shape_position=(0.0, 0.0, 0.0),
                  shape_orientation=(1.0, 0.0, 0.0, 0.0), damping=0.0, name=None, armature=0.0, stiffness=0.0,
                  springref=0.0, limits=None, margin=0.0, frictionloss=0.0, limit_softness=None,
-                 friction_softness=None) -> int:  # fmt: skip
+                 friction_softness=None, joint_name=None) -> int:  # fmt: skip
         """Add a link joined to ``parent`` by ``joint``; returns its index.
 
         Args:
@@ -252,6 +255,7 @@ class Articulation(JointDrives, Collisions):
             frictionloss: >= 0, dry friction [N m or N] on each of the joint's degrees of freedom: a constraint force
                 of at most that much against the motion, soft as ``friction_softness`` says (MuJoCo's joint
                 ``frictionloss``; ``constraints.py``).
+            joint_name: optional, unique among the joints: :meth:`joint` finds the joint by it.
         """
         if not isinstance(joint, Joint):
             raise TypeError(f"joint must be a Revolute, Prismatic, Ball, Free or Fixed, got {_show(joint)}")
@@ -282,11 +286,15 @@ class Articulation(JointDrives, Collisions):
             raise TypeError(f"name must be a string or None, got {_show(name)}")
         if name is not None and any(link.name == name for link in self._links):
             raise ValueError(f"name must be unique, got {name!r} (link {self.link_index(name)} has it)")
+        if joint_name is not None and not isinstance(joint_name, str):
+            raise TypeError(f"joint_name must be a string or None, got {_show(joint_name)}")
+        if joint_name is not None and any(link.joint_name == joint_name for link in self._links):
+            raise ValueError(f"joint_name must be unique, got {joint_name!r}")
         nq, nv = self.nq, self.nv
         link = Link(index, name, parent, joint, position, orientation, properties, damping,
                     slice(nq, nq + joint.nq), slice(nv, nv + joint.nv), shape, shape_position,
                     shape_orientation, armature, stiffness, springref, limits, margin, frictionloss, limit_softness,
-                    friction_softness)  # fmt: skip
+                    friction_softness, joint_name)  # fmt: skip
         if isinstance(joint, Ball):
             self._quat_starts.append((nq, index))
         elif isinstance(joint, Free):
@@ -346,6 +354,15 @@ class Articulation(JointDrives, Collisions):
             if link.name == name:
                 return link.index
         raise ValueError(f"name must be the name of a link, got {name!r}")
+
+    def joint(self, name: str) -> ArticulationJoint:
+        """The joint called ``name`` (its link's ``joint_name``; a model file's joint names): ``.angle``,
+        ``.angular_speed`` of a hinge, ``.translation``, ``.speed`` of a slide, settable."""
+        for link in self._links:
+            if link.joint_name == name and name is not None:
+                return ArticulationJoint(self, link.index, name)
+        names = sorted(link.joint_name for link in self._links if link.joint_name is not None)
+        raise KeyError(f"no joint named {name!r}; names: {names}")
 
     @property
     def gravity(self) -> np.ndarray:
@@ -628,13 +645,13 @@ class Articulation(JointDrives, Collisions):
             ints, reals = pack_model(self._links, self._loops, self._gravity, self._base_position,
                                      self._base_orientation, scalars, rows, geom_rows(self._geoms),
                                      pair_rows(self._links, self._geoms, self._excluded))  # fmt: skip
-            n, nq, nv, nl, ns, nc = counts(ints)
+            n = len(self._links)
             self._compiled = _Compiled(
-                ints, reals, np.zeros(work_size(n, nq, nv, nl, ns, nc)), np.zeros(nv), np.zeros((n, 6)), np.zeros(nv),
+                ints, reals, np.zeros(work_size(*counts(ints))), np.zeros(nv), np.zeros((n, 6)), np.zeros(nv),
                 np.zeros((0, nq + nv + 1)),
             )  # fmt: skip
             model = self._compiled.views()[0]
-            if ns or len(model.pair_ints):
+            if len(scalars) or len(model.pair_ints):
                 initial = np.concatenate([_initial_coordinates(link) for link in self._links])
                 mass_matrix = self._initial_mass_matrix(initial)
                 model.scalar_reals[:, INVWEIGHT] = invweights(self._links, model.scalar_v, mass_matrix)

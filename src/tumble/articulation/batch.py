@@ -61,11 +61,11 @@ class ArticulationBatch:
         self._links = articulation.links
         self._quat_starts = list(articulation._quat_starts)
         self._ints, self._reals = compiled.ints.copy(), compiled.reals.copy()
-        links, nq, nv, loops, scalars, contacts = counts(self._ints)
+        links, nq, nv, loops, scalars, contacts, geoms = counts(self._ints)
         # each copy: q, qd and tau (8 bytes an entry), and its failure row (3 int64)
         need = 8.0 * n * (nq + 2 * nv + 3)
         require_memory(need, f"n={n} copies of a {nq}-coordinate articulation", "use fewer copies")
-        self._work_size = work_size(links, nq, nv, loops, scalars, contacts)
+        self._work_size = work_size(links, nq, nv, loops, scalars, contacts, geoms)
         self._work = np.zeros((1, self._work_size))  # one work buffer per thread, grown as threads are used
         self._external = np.zeros((links, 6))
         self._failures = np.zeros((n, 3), dtype=np.int64)

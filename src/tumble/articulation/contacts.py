@@ -131,16 +131,39 @@ def _closest_between_segments(p0, p1, q0, q1):
     return add(p0, scale(d1, s)), add(q0, scale(d2, t))
 
 
+@inline
+def _pose(poses, g):
+    return (poses[g, 0], poses[g, 1], poses[g, 2]), (poses[g, 3], poses[g, 4], poses[g, 5], poses[g, 6])
+
+
+@inline
+def _reach(m, g):
+    """A sphere about a geom's centre that holds it (a plane has none: -1)."""
+    kind = m.geom_ints[g, GEOM_TYPE]
+    if kind == PLANE:
+        return -1.0
+    return m.geom_reals[g, GEOM_SIZE] + (m.geom_reals[g, GEOM_SIZE + 1] if kind == CAPSULE else 0.0)
+
+
 @inline(counted=False)
 def find_contacts(m, w):
     """The contacts of every pair at the link poses in ``w.link_work`` into ``w.contact_work``; returns their count."""
-    contacts, link_work = w.contact_work, w.link_work
+    contacts, poses = w.contact_work, w.geom_pose
+    for g in range(m.geom_ints.shape[0]):
+        pos, quat = _geom_pose(m, w.link_work, g)
+        for i in range(3):
+            poses[g, i] = pos[i]
+        for i in range(4):
+            poses[g, 3 + i] = quat[i]
     count = 0
     for k in range(m.pair_ints.shape[0]):
         ga, gb = m.pair_ints[k, PAIR_A], m.pair_ints[k, PAIR_B]
         margin = m.pair_reals[k, PAIR_MARGIN]
-        pos_a, quat_a = _geom_pose(m, link_work, ga)
-        pos_b, quat_b = _geom_pose(m, link_work, gb)
+        pos_a, quat_a = _pose(poses, ga)
+        pos_b, quat_b = _pose(poses, gb)
+        reach_a = _reach(m, ga)
+        if reach_a >= 0.0 and length3(sub(pos_b, pos_a)) > reach_a + _reach(m, gb) + margin:
+            continue  # their bounding spheres are apart
         radius_b = m.geom_reals[gb, GEOM_SIZE]
         b0, b1 = _segment(m, gb, pos_b, quat_b)
         if m.geom_ints[ga, GEOM_TYPE] == PLANE:  # mjc_PlaneSphere, and mjc_PlaneCapsule's two end spheres

@@ -65,7 +65,7 @@ def articulation_kernel(ints, reals, q, qd, vec_in, external, use_external, work
     ``SIMULATE`` only, the state is that before the failing step).
     """
     m = model_views(ints, reals)
-    w = work_views(work, ints[0], ints[1], ints[2], ints[3], ints[4], ints[8])
+    w = work_views(work, ints[0], ints[1], ints[2], ints[3], ints[4], ints[8], ints[6])
     if mode == FORWARD or mode == PROJECT:
         bad = accelerations(m, w, q, qd, vec_in, external, use_external, 0.0)
         if bad >= 0:
@@ -129,7 +129,7 @@ def batch_kernel(ints, reals, q, qd, tau, work, external, h, method, steps, firs
     buffer that it did not write first, so one buffer serves copy after copy (and stays in the cache).
     """
     m = model_views(ints, reals)
-    w = work_views(work, ints[0], ints[1], ints[2], ints[3], ints[4], ints[8])
+    w = work_views(work, ints[0], ints[1], ints[2], ints[3], ints[4], ints[8], ints[6])
     failed = 0
     for c in range(first, last):
         q_c, qd_c, tau_c = q[c], qd[c], tau[c]

@@ -70,6 +70,7 @@ GEOM_INT_WIDTH = 2
 GEOM_SIZE, GEOM_POS, GEOM_QUAT = 0, 3, 6
 GEOM_REAL_WIDTH = 10
 PLANE, SPHERE, CAPSULE = 0, 2, 3  # MuJoCo's mjtGeom numbers
+GEOM_POSE_WIDTH = 7
 # pair_ints / pair_reals columns: two geoms that may touch (geom A's type <= geom B's), the contact's dimension (1: no
 # friction, 3: a pyramid of four edges), and MuJoCo's mixed settings: friction, margin, solref (2), solimp (5) and the
 # regulariser's weight (``diagApprox``: both bodies' ``invweight0``, and for a pyramid ``2 μ² (1 + μ²) / impratio``)
@@ -171,6 +172,7 @@ class Work(NamedTuple):
         efc_jac: (rows, nv): the Jacobian of each active constraint row, rows = 3S + 4C; efc_minv_jt: (rows, nv):
             ``L⁻ᵀ Jᵀ`` (``H = Lᵀ D L``); efc_factor: (nv, nv): the pivoting's Cholesky factor; efc_z: (nv,): ``Σ fᵢ
             L⁻ᵀ Jᵢᵀ``; efc_inverse_pivots: (nv,): ``D⁻¹``; efc_work: (10, rows): the rows' data (``EFC_*``).
+        geom_pose: (G, 7): each geom's world position and quaternion at the state.
     """
 
     link_work: np.ndarray
@@ -192,6 +194,7 @@ class Work(NamedTuple):
     efc_z: np.ndarray
     efc_inverse_pivots: np.ndarray
     efc_work: np.ndarray
+    geom_pose: np.ndarray
 
 
 def _int_size(n: int, nv: int, loops: int, actuators: int, geoms: int, pairs: int) -> int:
@@ -204,11 +207,12 @@ def _real_size(n: int, nq: int, nv: int, loops: int, scalars: int, actuators: in
             + ACT_WIDTH * actuators + GEOM_REAL_WIDTH * geoms + PAIR_REAL_WIDTH * pairs)  # fmt: skip
 
 
-def work_size(n: int, nq: int, nv: int, loops: int, scalars: int, contacts: int) -> int:
+def work_size(n: int, nq: int, nv: int, loops: int, scalars: int, contacts: int, geoms: int) -> int:
     """The length of the work buffer that :func:`work_views` carves."""
     nc, nr = 3 * loops, 3 * scalars + 4 * contacts
     return (LINK_WORK_WIDTH * n + 12 * nv + nv * nv + DOF_WORK_ROWS * nv + 2 * nq + 2 * nc * nv + nc * nc + 4 * nc + 2
-            + CONTACT_WIDTH * contacts + 2 * nr * nv + nv * nv + 2 * nv + EFC_WORK_ROWS * nr)  # fmt: skip
+            + CONTACT_WIDTH * contacts + 2 * nr * nv + nv * nv + 2 * nv + EFC_WORK_ROWS * nr
+            + GEOM_POSE_WIDTH * geoms)  # fmt: skip
 
 
 @inline
@@ -260,7 +264,7 @@ def model_views(ints, reals):
 
 
 @inline
-def work_views(work, n, nq, nv, nl, ns, ncontacts):
+def work_views(work, n, nq, nv, nl, ns, ncontacts, ngeoms):
     """Carve ``work`` into a :class:`Work` of views."""
     nc, nr = 3 * nl, 3 * ns + 4 * ncontacts
     link_work = _rows(work, 0, n, LINK_WORK_WIDTH)
@@ -294,9 +298,11 @@ def work_views(work, n, nq, nv, nl, ns, ncontacts):
     efc_z, efc_inverse_pivots = work[w : w + nv], work[w + nv : w + 2 * nv]
     w += 2 * nv
     efc_work = _rows(work, w, EFC_WORK_ROWS, nr)
+    w += EFC_WORK_ROWS * nr
+    geom_pose = _rows(work, w, ngeoms, GEOM_POSE_WIDTH)
     return Work(link_work, dof_motion, dof_u, mass_matrix, dof_work, q_start, q_stage, loop_jac, loop_minv_jt,
                 loop_matrix, loop_work, energy, contact_work, efc_jac, efc_minv_jt, efc_factor, efc_z,
-                efc_inverse_pivots, efc_work)  # fmt: skip
+                efc_inverse_pivots, efc_work, geom_pose)  # fmt: skip
 
 
 def python_function(compiled):
@@ -304,10 +310,10 @@ def python_function(compiled):
     return getattr(compiled, "py_func", compiled)
 
 
-def counts(ints: np.ndarray) -> tuple[int, int, int, int, int, int]:
-    """``(link_count, q_count, v_count, loop_count, scalar_count, contact capacity)`` from the header of ``ints``:
-    the arguments of :func:`work_size` and :func:`work_views`."""
-    return int(ints[0]), int(ints[1]), int(ints[2]), int(ints[3]), int(ints[4]), int(ints[8])
+def counts(ints: np.ndarray) -> tuple[int, int, int, int, int, int, int]:
+    """``(link_count, q_count, v_count, loop_count, scalar_count, contact capacity, geom_count)`` from the header of
+    ``ints``: the arguments of :func:`work_size` and :func:`work_views`."""
+    return int(ints[0]), int(ints[1]), int(ints[2]), int(ints[3]), int(ints[4]), int(ints[8]), int(ints[6])
 
 
 def pack_model(links, loops, gravity, base_pos, base_quat, scalars=(), actuators=(), geoms=(),

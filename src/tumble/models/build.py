@@ -73,7 +73,8 @@ def to_articulation(model: ModelDescription) -> Articulation:
                                   springref=joint.springref, frictionloss=joint.frictionloss,
                                   limits=joint.range if joint.type in ("hinge", "slide") else None,
                                   margin=joint.margin, limit_softness=_softness(joint.limit_softness),
-                                  friction_softness=_softness(joint.friction_softness))  # fmt: skip
+                                  friction_softness=_softness(joint.friction_softness),
+                                  joint_name=joint.name)  # fmt: skip
             if joint.type in ("hinge", "slide") and joint.ref != 0.0:
                 initial.append((parent, joint.ref))
             if joint.name is not None:
