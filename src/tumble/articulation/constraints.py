@@ -126,6 +126,8 @@ def impedance(row, c, distance):
         return low
     if power == 1.0:
         y = x
+    elif power == 2.0:  # MuJoCo's default, without pow (the same roundings)
+        y = x * x / middle if x <= middle else 1.0 - (1.0 - x) * (1.0 - x) / (1.0 - middle)
     elif x <= middle:
         y = x**power / middle ** (power - 1.0)
     else:
