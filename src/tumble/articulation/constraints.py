@@ -38,6 +38,8 @@ from .model import (
     FRICTIONLOSS,
     GEAR,
     INVWEIGHT,
+    JOINT_Q,
+    JOINT_V,
     LIMIT_SOLIMP,
     LIMIT_SOLREF,
     LIMITED,
@@ -62,6 +64,20 @@ def scalar_value(coefficients, s, x):
     for j in range(x.shape[0]):
         total += coefficients[s, j] * x[j]
     return total
+
+
+@inline
+def scalar_length(m, s, q):
+    """Scalar ``s``'s length: its joint's coordinate, or the tendon's ``Σ cᵢ qᵢ``."""
+    row = int(m.scalar_reals[s, JOINT_Q])
+    return q[row] if row >= 0 else scalar_value(m.scalar_q, s, q)
+
+
+@inline
+def scalar_rate(m, s, qd):
+    """Scalar ``s``'s rate ``J q̇``."""
+    row = int(m.scalar_reals[s, JOINT_V])
+    return qd[row] if row >= 0 else scalar_value(m.scalar_v, s, qd)
 
 
 @inline(into_callers=True)
@@ -97,16 +113,20 @@ def _add_drives(m, q, qd, tau, out):
         stiffness, damping = scalar_reals[s, TENDON_STIFFNESS], scalar_reals[s, TENDON_DAMPING]
         if stiffness == 0.0 and damping == 0.0:
             continue
-        force = -damping * scalar_value(m.scalar_v, s, qd)
+        force = -damping * scalar_rate(m, s, qd)
         if stiffness != 0.0:
-            force -= stiffness * (scalar_value(m.scalar_q, s, q) - scalar_reals[s, TENDON_SPRINGLENGTH])
+            force -= stiffness * (scalar_length(m, s, q) - scalar_reals[s, TENDON_SPRINGLENGTH])
         for k in range(out.shape[0]):
             out[k] += force * m.scalar_v[s, k]
     for a in range(act_reals.shape[0]):
         s, gear = m.act_ints[a, 0], act_reals[a, GEAR]
-        length, speed = gear * scalar_value(m.scalar_q, s, q), gear * scalar_value(m.scalar_v, s, qd)
+        length, speed = gear * scalar_length(m, s, q), gear * scalar_rate(m, s, qd)
         force = act_reals[a, FORCE0] + act_reals[a, BIAS_LENGTH] * length + act_reals[a, BIAS_SPEED] * speed
         force = min(max(force, act_reals[a, FORCE_LOW]), act_reals[a, FORCE_HIGH])
+        joint = int(scalar_reals[s, JOINT_V])
+        if joint >= 0:
+            out[joint] += gear * force
+            continue
         for k in range(out.shape[0]):
             out[k] += gear * force * m.scalar_v[s, k]
 
@@ -186,7 +206,7 @@ def scalar_rows(m, w, q, qd, h):
         if loss > 0.0:
             count = _scalar_row(m, w, count, s, 1.0, 0.0, FRICTION_SOLREF, -loss, loss, h, qd)
         if row[LIMITED] != 0.0:
-            length, margin = scalar_value(m.scalar_q, s, q), row[MARGIN]
+            length, margin = scalar_length(m, s, q), row[MARGIN]
             if length - row[LOWER] < margin:
                 count = _scalar_row(m, w, count, s, 1.0, length - row[LOWER], LIMIT_SOLREF, 0.0, math.inf, h, qd)
             if row[UPPER] - length < margin:

@@ -23,6 +23,8 @@ from .model import (
     FRICTION_SOLREF,
     FRICTIONLOSS,
     GEAR,
+    JOINT_Q,
+    JOINT_V,
     LIMIT_SOLIMP,
     LIMIT_SOLREF,
     LIMITED,
@@ -110,8 +112,9 @@ def check_limits(name: str, limits) -> tuple[float, float] | None:
     return lower, upper
 
 
-def _columns(limits, margin, frictionloss, limit_softness, friction_softness, spring=(0.0, 0.0, 0.0)):
+def _columns(limits, margin, frictionloss, limit_softness, friction_softness, spring=(0.0, 0.0, 0.0), rows=(-1, -1)):
     row = np.zeros(SCALAR_WIDTH)
+    row[JOINT_Q], row[JOINT_V] = rows
     if limits is not None:
         row[LIMITED], row[LOWER], row[UPPER] = 1.0, limits[0], limits[1]
     row[MARGIN], row[FRICTIONLOSS] = margin, frictionloss
@@ -138,13 +141,14 @@ def scalar_rows(links, tendons, actuated, nq: int, nv: int):
             q_row[link.q_slice.start], v_row[link.v_slice.start] = 1.0, 1.0
             link_scalar[link.index] = len(rows)
             rows.append((q_row, v_row, _columns(link.limits, link.margin, link.frictionloss, link.limit_softness,
-                                                link.friction_softness)))  # fmt: skip
+                                                link.friction_softness,
+                                                rows=(link.q_slice.start, link.v_slice.start))))  # fmt: skip
         elif not scalar_joint and link.frictionloss > 0.0:
             for k in range(link.v_slice.start, link.v_slice.stop):
                 v_row = np.zeros(nv)
                 v_row[k] = 1.0
                 rows.append((np.zeros(nq), v_row, _columns(None, 0.0, link.frictionloss, link.limit_softness,
-                                                           link.friction_softness)))  # fmt: skip
+                                                           link.friction_softness, rows=(-1, k))))  # fmt: skip
     tendon_scalar = []
     for tendon in tendons:
         q_row, v_row = np.zeros(nq), np.zeros(nv)

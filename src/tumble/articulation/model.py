@@ -57,7 +57,9 @@ DOF_PARAM_WIDTH = 4
 LIMITED, LOWER, UPPER, MARGIN, LIMIT_SOLREF, LIMIT_SOLIMP = 0, 1, 2, 3, 4, 6
 FRICTIONLOSS, FRICTION_SOLREF, FRICTION_SOLIMP, INVWEIGHT = 11, 12, 14, 19
 TENDON_STIFFNESS, TENDON_SPRINGLENGTH, TENDON_DAMPING = 20, 21, 22
-SCALAR_WIDTH = 23
+# a joint's scalar is one coordinate: its rows of q and qd (-1 for a tendon), read without the dense coefficients
+JOINT_Q, JOINT_V = 23, 24
+SCALAR_WIDTH = 25
 # act_reals columns: an actuator on scalar ``act_ints[a, 0]`` pulls along ``l = GEAR · L`` with the force
 # ``FORCE0 + BIAS_LENGTH l + BIAS_SPEED l̇`` (FORCE0 = gain · clipped control + bias₀), clipped to
 # ``[FORCE_LOW, FORCE_HIGH]``
@@ -121,7 +123,7 @@ class Model(NamedTuple):
         loop_ints: (L, 2) int64: ``LINK_A``, ``LINK_B`` (-1: the world).
         loop_reals: (L, 6): ``POINT_A``, ``POINT_B`` [m], in the frames of link a and link b (or the world).
         scalar_q: (S, nq), scalar_v: (S, nv): each scalar's coefficients (a joint's or a fixed tendon's length).
-        scalar_reals: (S, 23): its limits, dry friction and tendon spring (the columns above).
+        scalar_reals: (S, 25): its limits, dry friction, tendon spring and joint rows (the columns above).
         act_ints: (A, 1) int64: each actuator's scalar; act_reals: (A, 6): its force law (the columns above).
         geom_ints: (G, 2) int64, geom_reals: (G, 10): the collision geoms; pair_ints: (P, 3) int64, pair_reals:
             (P, 10): the pairs that may touch (the columns above).
