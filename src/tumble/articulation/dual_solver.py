@@ -18,9 +18,8 @@ solution to rounding. Otherwise (a few rounds, or a cycle) the sweeps go on.
 
 from __future__ import annotations
 
-import math
-
 from .._jit import inline
+from ..dense import cholesky, cholesky_solve
 from .dynamics import dl_solve, lt_solve
 from .model import (
     EFC_AREF,
@@ -103,27 +102,9 @@ def _pivot(w, count, inverse_pivots, factor):
                     t[a] += ya * rhs * weight
                     for b in range(a + 1):
                         k_matrix[a, b] += ya * y[i, b] * weight
-        for a in range(nv):  # Cholesky of K, in its lower triangle
-            for b in range(a + 1):
-                total = k_matrix[a, b]
-                for c in range(b):
-                    total -= k_matrix[a, c] * k_matrix[b, c]
-                if a == b:
-                    if not total > 0.0:
-                        return False
-                    k_matrix[a, a] = math.sqrt(total)
-                else:
-                    k_matrix[a, b] = total / k_matrix[b, b]
-        for a in range(nv):
-            total = t[a]
-            for c in range(a):
-                total -= k_matrix[a, c] * t[c]
-            t[a] = total / k_matrix[a, a]
-        for a in range(nv - 1, -1, -1):
-            total = t[a]
-            for c in range(a + 1, nv):
-                total -= k_matrix[c, a] * t[c]
-            t[a] = total / k_matrix[a, a]
+        if not cholesky(k_matrix, nv):
+            return False
+        cholesky_solve(k_matrix, t, nv)
         for i in range(count):  # xᵢ = (bᵢ - yᵢ · u) / Rᵢ, u = K⁻¹ t
             if e[EFC_STATE, i] == 0.0:
                 projected = 0.0

@@ -46,6 +46,7 @@ import numpy as np
 
 from .. import elementary
 from .._jit import inline, kernel
+from ..dense import cholesky, cholesky_solve
 from ..math3d import (
     add,
     add_scaled,
@@ -301,39 +302,6 @@ def _block_mass(rows, ma, ia, mb, ib, dir_l, dir_a, dir_b, k):
 
 
 @inline
-def _cholesky(k, n):
-    """Factorise the SPD ``K`` (n × n) in place into its lower Cholesky factor; False if it is singular."""
-    for c in range(n):
-        s = k[c, c]
-        for t in range(c):
-            s -= k[c, t] * k[c, t]
-        if s <= 1e-12 * max(k[c, c], 1e-300):
-            return False
-        k[c, c] = math.sqrt(s)
-        for r in range(c + 1, n):
-            s = k[r, c]
-            for t in range(c):
-                s -= k[r, t] * k[c, t]
-            k[r, c] = s / k[c, c]
-    return True
-
-
-@inline
-def _cholesky_solve(k, x, n):
-    """Solve ``L Lᵀ y = x`` in place (``x`` becomes ``y``) with the factor from :func:`_cholesky`."""
-    for r in range(n):
-        s = x[r]
-        for t in range(r):
-            s -= k[r, t] * x[t]
-        x[r] = s / k[r, r]
-    for r in range(n - 1, -1, -1):
-        s = x[r]
-        for t in range(r + 1, n):
-            s -= k[t, r] * x[t]
-        x[r] = s / k[r, r]
-
-
-@inline
 def _block_impulse(rows, linear_rows, lam, dir_l, dir_a, dir_b):
     """The block's impulses ``λ`` as world vectors: linear ``Σ λ l``, angular ``Σ λ n`` (angular rows), and the
     moments they exert on a and b (``Σ λ α``, ``Σ λ β``)."""
@@ -361,7 +329,7 @@ def _held_direction(dl, da, db, rows, linear_rows, ma, ia, mb, ib, dir_l, dir_a,
         )
         y[r] = k_bd[r]
     if solvable:
-        _cholesky_solve(k_block, y, rows)
+        cholesky_solve(k_block, y, rows)
     k_dd = (ma + mb) * dot(dl, dl) + dot(da, mat_vec(ia, da)) + dot(db, mat_vec(ib, db))
     block_p, block_m = (0.0, 0.0, 0.0), (0.0, 0.0, 0.0)
     for r in range(rows if solvable else 0):
@@ -470,7 +438,7 @@ def solve_joints(joints, impulses, inv_mass, inv_inertia_world, pos, quat, linve
         # The rigid block (anchors together or across the slider's axis, axes aligned): rows and factorised mass.
         rows, linear_rows = _block_rows(kind, fa, fb, arm, rb, d, dir_l, dir_a, dir_b, error)
         _block_mass(rows, ma, ia, mb, ib, dir_l, dir_a, dir_b, k_block)
-        solvable = _cholesky(k_block, rows)
+        solvable = cholesky(k_block, rows)
         # Drive along the free axis: spring, motor, limits (rod: a rigid distance), each row acting on the joint
         # *with its block held*: the row's direction minus its block response y = K⁻¹ K_B,d (a Schur complement),
         # so that a hinge limit stops a pendulum bob swinging round the pivot, not just its spin about its COM.
@@ -554,7 +522,7 @@ def solve_joints(joints, impulses, inv_mass, inv_inertia_world, pos, quat, linve
                 lr, ar, br = load3(dir_l, r), load3(dir_a, r), load3(dir_b, r)
                 rate = dot(lr, sub(vb, va)) - dot(ar, wa) + dot(br, wb)
                 rhs[r] = -m_scale * (rate + bias_rate * error[r])
-            _cholesky_solve(k_block, rhs, rows)
+            cholesky_solve(k_block, rhs, rows)
             for r in range(rows):
                 old_r = dot(old_p, load3(dir_l, r)) if r < linear_rows else dot(old_m, load3(dir_a, r))
                 rhs[r] -= i_scale * old_r
