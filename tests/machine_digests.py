@@ -111,9 +111,9 @@ def _digest(*arrays) -> str:
 
 def model_digests(world) -> dict:
     out: dict = {}
-    if not isinstance(world, tumble.World):  # an articulation: its packed model and its state
-        compiled = world._compile()
-        return {"model": _digest(compiled.ints, compiled.reals), "state": _digest(world.q, world.qd)}
+    if not isinstance(world, tumble.World):  # an articulation: what its model makes of its first state, and the state
+        model = (world.mass_matrix(), world.contact_pairs, world.forward_dynamics())
+        return {"model": _digest(*model), "state": _digest(world.q, world.qd)}
     _array_digests("model", world.model, out)
     _array_digests("state", world.state, out)
     return out

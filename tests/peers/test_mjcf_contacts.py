@@ -85,21 +85,26 @@ def test_contacts_and_accelerations_equal_mujocos_at_random_overlapping_states()
     assert {("ball", "floor"), ("floor", "rod"), ("floor", "knob"), ("ball", "rod"), ("ball", "knob")} <= kinds
 
 
+@pytest.mark.parametrize("dt", [1e-3, 1 / 240])
 @pytest.mark.parametrize("seed", [0, 1, 2])
-def test_a_tumbling_body_lands_and_rests_as_mujocos_does(seed):
+def test_a_tumbling_body_lands_and_rests_as_mujocos_does(seed, dt):
     """Two free bodies thrown onto a tilted plane (and onto each other) with random velocities: two seconds of RK4 at
-    1 kHz follow MuJoCo's trajectory to 1e-9 (impacts, sliding, rolling and rest)."""
+    1 kHz and at 240 Hz follow MuJoCo's trajectory at the same step to 1e-7 m (impacts, sliding, rolling and rest; at
+    240 Hz the contacts' time constants are held at twice the step, in both engines). Measured: 4e-12 at 1 kHz; at
+    240 Hz the two solvers' last digits (KKT to 1e-12 here, Newton to 1e-15 there) part at the first impact and the
+    bodies' collisions grow that to 3e-11 to 7e-9."""
     art = from_mjcf(_SCENE)
     model, data = _mujoco(_SCENE)
+    model.opt.timestep = dt
     data.qvel[:] = np.random.default_rng(seed).normal(scale=1.5, size=model.nv)
     art.qd = data.qvel
     worst, touching = 0.0, 0
-    for _ in range(2000):
+    for _ in range(round(2.0 / dt)):
         mujoco.mj_step(model, data)
-        art.step(0.001, integrator="rk4")
+        art.step(dt, integrator="rk4")
         worst = max(worst, np.max(np.abs(art.q - data.qpos)))
         touching = max(touching, data.ncon)
-    assert worst < 1e-9
+    assert worst < 1e-7
     assert touching >= 2
 
 
@@ -166,11 +171,33 @@ def test_the_locomotion_models_come_to_rest_where_mujocos_do(name):
         assert ours == pytest.approx(theirs.qpos[0], abs=0.01)
 
 
-def test_the_humanoid_falls_and_lies_with_no_shapes_overlapping_by_more_than_5_mm():
+@pytest.mark.parametrize("dt", [1 / 240, 1e-3])
+@pytest.mark.parametrize("name", ["hopper", "ant"])
+def test_models_rest_as_mujocos_do_at_240_hz_and_1_khz(name, dt):
+    """The hopper and the ant dropped with zero control for 5 s at 240 Hz and at 1 kHz (RK4 in both engines): the
+    torso where MuJoCo's is at the same step."""
+    path = os.path.join(ASSETS, f"{name}.xml")
+    model = mujoco.MjModel.from_xml_path(path)
+    model.opt.timestep = dt
+    data = mujoco.MjData(model)
+    art = from_mjcf(path)
+    steps = round(5.0 / dt)
+    mujoco.mj_step(model, data, nstep=steps)
+    art.simulate(5.0, dt, integrator="rk4", record_every=steps)
+    ours, theirs = art.link_poses()[0][art.link_index("torso")], data.xpos[model.body("torso").id]
+    assert np.max(np.abs(ours - theirs)) < 1e-6
+
+
+@pytest.mark.parametrize("seed", [None, 1, 2])
+def test_the_humanoid_falls_and_lies_with_no_shapes_overlapping_by_more_than_5_mm(seed):
+    """From its model pose (``None``) and from two random pushes of its joints, in both engines alike."""
     path = os.path.join(ASSETS, "humanoid.xml")
     art = from_mjcf(path)
     model = mujoco.MjModel.from_xml_path(path)
     data = mujoco.MjData(model)
+    if seed is not None:
+        data.qvel[6:] = np.random.default_rng(seed).normal(scale=2.0, size=model.nv - 6)
+        art.qd = data.qvel
     dt = model.opt.timestep
     art.simulate(5.0, dt, integrator="rk4", record_every=1000)
     deepest = min(art.contacts().distance)
@@ -185,7 +212,7 @@ def test_the_humanoid_falls_and_lies_with_no_shapes_overlapping_by_more_than_5_m
 
 def _pairs(art):
     """The pairs of geom names that may touch."""
-    return {frozenset((art.geoms[a].name, art.geoms[b].name)) for a, b in art._compile().views()[0].pair_ints[:, :2]}
+    return {frozenset((art.geoms[a].name, art.geoms[b].name)) for a, b in art.contact_pairs}
 
 
 def test_contact_filters_one_body_its_parent_bits_and_exclusions():

@@ -33,13 +33,13 @@ from ..mass import MassProperties
 from ..rotation import quat_from_rotvec, quat_multiply, quat_to_matrix
 from ..shapes import Shape
 from .actuators import Actuator
-from .collision import Collisions, Geom, geom_rows, pair_rows, pair_weights, translation_weight
+from .collision import Collisions, Geom, pack_geoms, pack_pairs, pair_weights, translation_weight
 from .drives import JointDrives, softness
 from .integrators import EULER, NOT_FINITE, RK4, SYMPLECTIC
 from .joint_view import ArticulationJoint
 from .joints import Ball, Free, Joint, Prismatic, Revolute
 from .kernels import CONTACTS, FORWARD, INVERSE, KINEMATICS, MASS_MATRIX, PROJECT, SIMULATE, articulation_kernel
-from .limits import SoftConstraint, Tendon, actuator_rows, check_limits, invweights, readonly, scalar_rows
+from .limits import SoftConstraint, Tendon, check_limits, invweights, pack_actuators, pack_scalars, readonly
 from .loops import LoopClosure
 from .model import (
     CONTACT_DIST,
@@ -639,12 +639,12 @@ class Articulation(JointDrives, Collisions):
         if self._compiled is None:
             nq, nv = self.nq, self.nv
             actuated = {a.link for a in self._actuators if a.link is not None}
-            scalars, link_scalar, tendon_scalar = scalar_rows(self._links, self._tendons, actuated, nq, nv)
-            rows = actuator_rows(self._actuators, lambda a: link_scalar[a.link] if a.tendon is None
+            scalars, link_scalar, tendon_scalar = pack_scalars(self._links, self._tendons, actuated, nq, nv)
+            rows = pack_actuators(self._actuators, lambda a: link_scalar[a.link] if a.tendon is None
                                  else tendon_scalar[a.tendon], self._ctrl)  # fmt: skip
             ints, reals = pack_model(self._links, self._loops, self._gravity, self._base_position,
-                                     self._base_orientation, scalars, rows, geom_rows(self._geoms),
-                                     pair_rows(self._links, self._geoms, self._excluded))  # fmt: skip
+                                     self._base_orientation, scalars, rows, pack_geoms(self._geoms),
+                                     pack_pairs(self._links, self._geoms, self._excluded))  # fmt: skip
             n = len(self._links)
             self._compiled = _Compiled(
                 ints, reals, np.zeros(work_size(*counts(ints))), np.zeros(nv), np.zeros((n, 6)), np.zeros(nv),
@@ -654,8 +654,9 @@ class Articulation(JointDrives, Collisions):
             if len(scalars) or len(model.pair_ints):
                 initial = np.concatenate([_initial_coordinates(link) for link in self._links])
                 mass_matrix = self._initial_mass_matrix(initial)
-                model.scalar_reals[:, INVWEIGHT] = invweights(self._links, model.scalar_v, mass_matrix)
-                weights = {link: translation_weight(self.jacobian(link, self._com_point(link), initial), mass_matrix)
+                inverse = portable.solve(mass_matrix, np.eye(len(mass_matrix)))  # once, for every weight
+                model.scalar_reals[:, INVWEIGHT] = invweights(self._links, model.scalar_v, inverse)
+                weights = {link: translation_weight(self.jacobian(link, self._com_point(link), initial), inverse)
                            for link in {g.link for g in self._geoms if g.link is not None}}  # fmt: skip
                 pair_weights(model.pair_ints, model.pair_reals, self._geoms, weights, self._impratio)
         return self._compiled

@@ -46,7 +46,7 @@ from .model import (
     SPHERE,
 )
 
-__all__ = ["Collisions", "Geom", "geom_rows", "pair_rows", "pair_weights"]
+__all__ = ["Collisions", "Geom", "pack_geoms", "pack_pairs", "pair_weights"]
 
 KINDS = {"plane": PLANE, "sphere": SPHERE, "capsule": CAPSULE}
 _SIZES = {"plane": 0, "sphere": 1, "capsule": 2}
@@ -83,7 +83,7 @@ class Geom:
 
 class Collisions:
     """Geoms and contact exclusions. Expects of the class it is mixed into: ``_links``, ``_loops``, ``_geoms``,
-    ``_excluded``, ``_compiled`` (reset to ``None`` when the model changes) and ``_check_link``."""
+    ``_excluded``, ``_compiled`` (reset to ``None`` when the model changes), ``_compile`` and ``_check_link``."""
 
     def add_geom(self, link, kind, size=(), *, position=(0.0, 0.0, 0.0), orientation=(1.0, 0.0, 0.0, 0.0), contype=1,
                  conaffinity=1, condim=3, friction=1.0, margin=0.0, softness=None, solmix=1.0,
@@ -137,6 +137,12 @@ class Collisions:
     def geoms(self) -> tuple[Geom, ...]:
         return tuple(self._geoms)
 
+    @property
+    def contact_pairs(self) -> np.ndarray:
+        """(P, 2) the geoms of every pair that may touch, after the filter (the first geom of a pair the one of the
+        lower MuJoCo type: a contact's normal points from it to the other)."""
+        return self._compile().views()[0].pair_ints[:, :2].copy()
+
     def exclude_contacts(self, link_a, link_b) -> None:
         """Let no geom of ``link_a``'s body touch one of ``link_b``'s (``None``: the world): MuJoCo's ``<exclude>``."""
         welds = [_weld(self._links, None if link is None else self._check_link(label, link))
@@ -172,7 +178,7 @@ def _may_touch(links, carriers, excluded, a: Geom, b: Geom) -> bool:
     return frozenset((weld_a, weld_b)) not in excluded
 
 
-def geom_rows(geoms):
+def pack_geoms(geoms):
     """``pack_model``'s ``geoms``."""
     rows = []
     for geom in geoms:
@@ -184,7 +190,7 @@ def geom_rows(geoms):
     return rows
 
 
-def pair_rows(links, geoms, excluded):
+def pack_pairs(links, geoms, excluded):
     """``pack_model``'s ``pairs`` (their weights still zero: :func:`pair_weights`), the lower MuJoCo type first."""
     carriers = {link.index for link in links if link.mass_properties is not None}
     carriers |= {geom.link for geom in geoms if geom.link is not None}
@@ -218,9 +224,9 @@ def pair_weights(pair_ints, pair_reals, geoms, translation_weights, impratio: fl
         reals[PAIR_WEIGHT] = weight
 
 
-def translation_weight(jacobian: np.ndarray, mass_matrix: np.ndarray) -> float:
+def translation_weight(jacobian: np.ndarray, inverse: np.ndarray) -> float:
     """MuJoCo's translational ``body_invweight0``: the mean of ``J H⁻¹ Jᵀ``'s diagonal over the three rows of a
-    body's centre-of-mass Jacobian (``jacobian`` (6, nv), rows linear then angular)."""
+    body's centre-of-mass Jacobian (``jacobian`` (6, nv), rows linear then angular; ``inverse``: ``H⁻¹``)."""
     linear = jacobian[:3]
-    solved = portable.solve(mass_matrix, linear.T)
+    solved = portable.matmul(inverse, linear.T)
     return math.fsum(math.fsum(linear[i] * solved[:, i]) for i in range(3)) / 3.0

@@ -142,7 +142,7 @@ class JointDrives:
     def ctrl(self, value) -> None:
         self._ctrl = self._check_vector("ctrl", value, len(self._actuators))
         if self._compiled is not None:
-            # each actuator's gain · (control clipped to its range) + bias₀, as actuator_rows packs it
+            # each actuator's gain · (control clipped to its range) + bias₀, as pack_actuators packs it
             gain, bias, low, high = self._control_law()
             self._compiled.views()[0].act_reals[:, FORCE0] = gain * np.minimum(np.maximum(self._ctrl, low), high) + bias
 

@@ -71,7 +71,7 @@ def _gather(y, e, row, count, z):
 def _pivot(w, count, inverse_pivots, factor):
     """Block principal pivoting from the active set of ``EFC_FORCE``; True (the solution in ``EFC_FORCE`` and
     ``w.efc_z``) when it ends at the KKT conditions."""
-    e, y, k_matrix, z = w.efc_work, w.efc_minv_jt, w.efc_factor, w.efc_z
+    e, y, k_matrix, z = w.efc_work, w.efc_jac, w.efc_factor, w.efc_z
     nv = z.shape[0]
     scale = 0.0
     for i in range(count):
@@ -138,15 +138,14 @@ def solve_constraints(m, w, count, factor, qdd):
     ``factor``: ``H``'s LTDL factor (``dynamics.ltdl_factor``). The rows' forces stay in ``w.efc_work``."""
     if count == 0:
         return
-    e, jac, y, z, nv = w.efc_work, w.efc_jac, w.efc_minv_jt, w.efc_z, qdd.shape[0]
+    e, y, z, nv = w.efc_work, w.efc_jac, w.efc_z, qdd.shape[0]
     inverse_pivots = w.efc_inverse_pivots
     for k in range(nv):
         inverse_pivots[k] = 1.0 / factor[k, k]
-    for i in range(count):  # yᵢ = L⁻ᵀ Jᵢᵀ, the diagonal of A, the offsets J q̈₀ - aref
+    for i in range(count):  # the offsets J q̈₀ - aref, then yᵢ = L⁻ᵀ Jᵢᵀ in place of Jᵢ, and the diagonal of A
         offset = 0.0
         for k in range(nv):
-            y[i, k] = jac[i, k]
-            offset += jac[i, k] * qdd[k]
+            offset += y[i, k] * qdd[k]
         lt_solve(m.dof_ints, factor, y[i])
         e[EFC_OFFSET, i] = offset - e[EFC_AREF, i]
         e[EFC_DIAG, i] = _weighted_dot(y, i, inverse_pivots, y[i])

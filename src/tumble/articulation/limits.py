@@ -37,7 +37,7 @@ from .model import (
     UPPER,
 )
 
-__all__ = ["SoftConstraint", "Tendon", "actuator_rows", "check_limits", "invweights", "readonly", "scalar_rows"]
+__all__ = ["SoftConstraint", "Tendon", "pack_actuators", "check_limits", "invweights", "readonly", "pack_scalars"]
 
 # MuJoCo clamps an impedance into [mjMINIMP, mjMAXIMP]
 _MIN_IMPEDANCE, _MAX_IMPEDANCE = 1e-4, 0.9999
@@ -126,7 +126,7 @@ def _columns(limits, margin, frictionloss, limit_softness, friction_softness, sp
     return row
 
 
-def scalar_rows(links, tendons, actuated, nq: int, nv: int):
+def pack_scalars(links, tendons, actuated, nq: int, nv: int):
     """The scalars of the model (``pack_model``'s ``scalars``) and the index of each link's and tendon's scalar.
 
     A Revolute or Prismatic link gets one when it has limits, dry friction or an actuator (``actuated``: the set of
@@ -162,7 +162,7 @@ def scalar_rows(links, tendons, actuated, nq: int, nv: int):
     return rows, link_scalar, tendon_scalar
 
 
-def actuator_rows(actuators, scalar_of, ctrl: np.ndarray):
+def pack_actuators(actuators, scalar_of, ctrl: np.ndarray):
     """``pack_model``'s ``actuators``: each actuator's scalar (``scalar_of(actuator)``) and force law at the controls
     ``ctrl``."""
     rows = []
@@ -177,11 +177,11 @@ def actuator_rows(actuators, scalar_of, ctrl: np.ndarray):
     return rows
 
 
-def invweights(links, scalar_v: np.ndarray, mass_matrix: np.ndarray) -> np.ndarray:
-    """MuJoCo's ``invweight0`` of each scalar from ``H`` at the initial coordinates: ``J H⁻¹ Jᵀ`` for a tendon or a
-    hinge's or slide's coordinate; for a degree of freedom of a ball (free) joint the mean of ``H⁻¹``'s diagonal over
-    the joint's rotations (and, apart, its translations), as MuJoCo's ``mj_setConst`` averages them."""
-    inverse_diagonal = np.diag(portable.solve(mass_matrix, np.eye(mass_matrix.shape[0]))).copy()
+def invweights(links, scalar_v: np.ndarray, inverse: np.ndarray) -> np.ndarray:
+    """MuJoCo's ``invweight0`` of each scalar from ``H⁻¹`` (``inverse``) at the initial coordinates: ``J H⁻¹ Jᵀ`` for a
+    tendon or a hinge's or slide's coordinate; for a degree of freedom of a ball (free) joint the mean of ``H⁻¹``'s
+    diagonal over the joint's rotations (and, apart, its translations), as MuJoCo's ``mj_setConst`` averages them."""
+    inverse_diagonal = np.diag(inverse).copy()
     for link in links:
         if isinstance(link.joint, (Ball, Free)):
             first = link.v_slice.start
@@ -193,5 +193,5 @@ def invweights(links, scalar_v: np.ndarray, mass_matrix: np.ndarray) -> np.ndarr
         if len(support) == 1 and row[support[0]] == 1.0:
             weights[s] = inverse_diagonal[support[0]]
         else:
-            weights[s] = math.fsum(row * portable.solve(mass_matrix, row))
+            weights[s] = math.fsum(row * portable.matvec(inverse, row))
     return weights

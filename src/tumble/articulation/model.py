@@ -80,7 +80,6 @@ PAIR_A, PAIR_B, PAIR_CONDIM = 0, 1, 2
 PAIR_INT_WIDTH = 3
 PAIR_FRICTION, PAIR_MARGIN, PAIR_SOLREF, PAIR_SOLIMP, PAIR_WEIGHT = 0, 1, 2, 4, 9
 PAIR_REAL_WIDTH = 10
-MAX_PAIR_CONTACTS = 2  # a capsule on a plane touches at both ends
 # contact_work columns: a contact's point (world), normal (from geom A to B), distance, pair, and the direction its
 # first tangent is made from (zero: MuJoCo's default)
 CONTACT_POINT, CONTACT_NORMAL, CONTACT_DIST, CONTACT_PAIR, CONTACT_TANGENT = 0, 3, 6, 7, 8
@@ -171,8 +170,8 @@ class Work(NamedTuple):
         loop_work: (4, 3L): rows ``LOOP_RHS`` (γ), ``LOOP_LAMBDA``, ``LOOP_ACTIVE``, ``LOOP_ERROR`` (φ).
         energy: (2,) [J]: kinetic and potential.
         contact_work: (C, 11): the contacts found (the ``CONTACT_*`` columns), C the most the pairs can make.
-        efc_jac: (rows, nv): the Jacobian of each active constraint row, rows = 3S + 4C; efc_minv_jt: (rows, nv):
-            ``L⁻ᵀ Jᵀ`` (``H = Lᵀ D L``); efc_factor: (nv, nv): the pivoting's Cholesky factor; efc_z: (nv,): ``Σ fᵢ
+        efc_jac: (rows, nv): the Jacobian of each active constraint row, rows = 3S + 4C, turned into ``L⁻ᵀ Jᵀ`` (``H =
+            Lᵀ D L``) in place by the solve; efc_factor: (nv, nv): the pivoting's Cholesky factor; efc_z: (nv,): ``Σ fᵢ
             L⁻ᵀ Jᵢᵀ``; efc_inverse_pivots: (nv,): ``D⁻¹``; efc_work: (10, rows): the rows' data (``EFC_*``).
         geom_pose: (G, 7): each geom's world position and quaternion at the state.
     """
@@ -191,7 +190,6 @@ class Work(NamedTuple):
     energy: np.ndarray
     contact_work: np.ndarray
     efc_jac: np.ndarray
-    efc_minv_jt: np.ndarray
     efc_factor: np.ndarray
     efc_z: np.ndarray
     efc_inverse_pivots: np.ndarray
@@ -213,7 +211,7 @@ def work_size(n: int, nq: int, nv: int, loops: int, scalars: int, contacts: int,
     """The length of the work buffer that :func:`work_views` carves."""
     nc, nr = 3 * loops, 3 * scalars + 4 * contacts
     return (LINK_WORK_WIDTH * n + 12 * nv + nv * nv + DOF_WORK_ROWS * nv + 2 * nq + 2 * nc * nv + nc * nc + 4 * nc + 2
-            + CONTACT_WIDTH * contacts + 2 * nr * nv + nv * nv + 2 * nv + EFC_WORK_ROWS * nr
+            + CONTACT_WIDTH * contacts + nr * nv + nv * nv + 2 * nv + EFC_WORK_ROWS * nr
             + GEOM_POSE_WIDTH * geoms)  # fmt: skip
 
 
@@ -293,8 +291,6 @@ def work_views(work, n, nq, nv, nl, ns, ncontacts, ngeoms):
     w += ncontacts * CONTACT_WIDTH
     efc_jac = _rows(work, w, nr, nv)
     w += nr * nv
-    efc_minv_jt = _rows(work, w, nr, nv)
-    w += nr * nv
     efc_factor = _rows(work, w, nv, nv)
     w += nv * nv
     efc_z, efc_inverse_pivots = work[w : w + nv], work[w + nv : w + 2 * nv]
@@ -303,7 +299,7 @@ def work_views(work, n, nq, nv, nl, ns, ncontacts, ngeoms):
     w += EFC_WORK_ROWS * nr
     geom_pose = _rows(work, w, ngeoms, GEOM_POSE_WIDTH)
     return Work(link_work, dof_motion, dof_u, mass_matrix, dof_work, q_start, q_stage, loop_jac, loop_minv_jt,
-                loop_matrix, loop_work, energy, contact_work, efc_jac, efc_minv_jt, efc_factor, efc_z,
+                loop_matrix, loop_work, energy, contact_work, efc_jac, efc_factor, efc_z,
                 efc_inverse_pivots, efc_work, geom_pose)  # fmt: skip
 
 
@@ -316,6 +312,13 @@ def counts(ints: np.ndarray) -> tuple[int, int, int, int, int, int, int]:
     """``(link_count, q_count, v_count, loop_count, scalar_count, contact capacity, geom_count)`` from the header of
     ``ints``: the arguments of :func:`work_size` and :func:`work_views`."""
     return int(ints[0]), int(ints[1]), int(ints[2]), int(ints[3]), int(ints[4]), int(ints[8]), int(ints[6])
+
+
+def _most_contacts(geoms, pairs) -> int:
+    """The most contacts the pairs can make at once: a capsule on a plane touches at both ends, any other pair at one
+    point (``contacts.find_contacts``)."""
+    kinds = [int(int_columns[GEOM_TYPE]) for int_columns, _ in geoms]
+    return sum(2 if (kinds[int(c[PAIR_A])], kinds[int(c[PAIR_B])]) == (PLANE, CAPSULE) else 1 for c, _ in pairs)
 
 
 def pack_model(links, loops, gravity, base_pos, base_quat, scalars=(), actuators=(), geoms=(),
@@ -335,7 +338,7 @@ def pack_model(links, loops, gravity, base_pos, base_quat, scalars=(), actuators
     nv = sum(link.joint.nv for link in links)
     ints = np.zeros(_int_size(n, nv, nl, na, ng, npairs), dtype=np.int64)
     reals = np.zeros(_real_size(n, nq, nv, nl, ns, na, ng, npairs), dtype=np.float64)
-    ints[:_HEADER] = (n, nq, nv, nl, ns, na, ng, npairs, MAX_PAIR_CONTACTS * npairs)
+    ints[:_HEADER] = (n, nq, nv, nl, ns, na, ng, npairs, _most_contacts(geoms, pairs))
     m = python_function(model_views)(ints, reals)
     m.world[GRAVITY : GRAVITY + 3], m.world[BASE_POS : BASE_POS + 3] = gravity, base_pos
     m.world[BASE_QUAT : BASE_QUAT + 4] = base_quat
