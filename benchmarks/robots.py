@@ -17,6 +17,9 @@ motors. Two ways of running ``seconds`` of simulated time:
 
 Columns: ``realtime`` (simulated seconds per wall-clock second, best of ``repeat``) and ``x_mujoco`` (tumble's
 real-time factor over MuJoCo's in the same mode: above 1 tumble is faster). Timings are never pass/fail tests.
+
+Then the same at ten times the size: ``chain of N``, a chain of N capsules (a free root, hinges with ranges) lying on
+a plane, every capsule free to touch every other but its neighbours (N = 10 and 100), in ``simulate``.
 """
 
 from __future__ import annotations
@@ -101,7 +104,18 @@ def _mujoco_run(path: str, seconds: float, loop: bool) -> float:
     return time.perf_counter() - start
 
 
-def bench_robots(seconds: float = 2.0, repeat: int = 3, models=MODELS) -> list[dict]:
+def chain_mjcf(links: int) -> str:
+    """A chain of ``links`` capsules of 0.1 m, a free root 0.3 m over a plane, hinges about y limited to ±30°."""
+    body = ""
+    for i in reversed(range(links)):
+        joint = "<freejoint/>" if i == 0 else '<joint axis="0 1 0" range="-30 30" damping="0.01"/>'
+        pos = "0 0 0.3" if i == 0 else "0.1 0 0"
+        body = f'<body pos="{pos}">{joint}<geom type="capsule" fromto="0 0 0 0.1 0 0" size="0.02"/>{body}</body>'
+    return (f'<mujoco model="chain of {links}"><option timestep="0.002" integrator="RK4"/><worldbody>'
+            f'<geom type="plane" size="10 10 1"/>{body}</worldbody></mujoco>')  # fmt: skip
+
+
+def bench_robots(seconds: float = 2.0, repeat: int = 3, models=MODELS, chains=(10, 100)) -> list[dict]:
     """One row per model, engine and mode."""
     folder = _assets()
     if folder is None:
@@ -110,14 +124,32 @@ def bench_robots(seconds: float = 2.0, repeat: int = 3, models=MODELS) -> list[d
         import mujoco  # noqa: F401
     except ImportError:
         return []
+    files = []
+    for links in chains:
+        path = os.path.join(os.environ.get("TMPDIR", "/tmp"), f"tumble_bench_chain_{links}_{os.getpid()}.xml")
+        with open(path, "w") as file:
+            file.write(chain_mjcf(links))
+        files.append((f"chain of {links}", path))
+    named = [(name, os.path.join(folder, f"{name}.xml")) for name in models] + files
+    try:
+        rows = _rows(named, seconds, repeat, chains=[name for name, _ in files])
+    finally:
+        for _, path in files:
+            os.unlink(path)
+    return rows
+
+
+def _rows(named, seconds: float, repeat: int, chains) -> list[dict]:
+    """The rows of each model; a chain runs ``simulate`` only, at most 0.5 s (the 100-capsule one is slow)."""
     rows = []
-    for name in models:
-        path = os.path.join(folder, f"{name}.xml")
-        for mode, loop in (("simulate", False), ("step loop", True)):
-            walls = {"tumble": min(_tumble_run(path, seconds, loop) for _ in range(repeat)),
-                     "MuJoCo": min(_mujoco_run(path, seconds, loop) for _ in range(repeat))}  # fmt: skip
+    for name, path in named:
+        chain = name in chains
+        run_seconds = min(seconds, 0.5) if chain else seconds
+        for mode, loop in (("simulate", False),) if chain else (("simulate", False), ("step loop", True)):
+            walls = {"tumble": min(_tumble_run(path, run_seconds, loop) for _ in range(repeat)),
+                     "MuJoCo": min(_mujoco_run(path, run_seconds, loop) for _ in range(repeat))}  # fmt: skip
             for engine, wall in walls.items():
-                rows.append({"model": name, "mode": mode, "engine": engine, "realtime": seconds / wall,
+                rows.append({"model": name, "mode": mode, "engine": engine, "realtime": run_seconds / wall,
                              "x_mujoco": walls["MuJoCo"] / wall})  # fmt: skip
     return rows
 

@@ -310,10 +310,12 @@ def test_robots_rows_for_both_engines_and_modes():
     pytest.importorskip("gymnasium")
     from benchmarks import robots
 
-    rows = robots.bench_robots(seconds=0.02, repeat=1, models=("hopper",))
+    rows = robots.bench_robots(seconds=0.02, repeat=1, models=("hopper",), chains=(3,))
     _assert_finite_numbers(rows)
-    assert {(r["engine"], r["mode"]) for r in rows} == {(e, m) for e in ("tumble", "MuJoCo")
-                                                         for m in ("simulate", "step loop")}  # fmt: skip
+    assert {(r["model"], r["engine"], r["mode"]) for r in rows} == {
+        *((m, e, mode) for m in ("hopper",) for e in ("tumble", "MuJoCo") for mode in ("simulate", "step loop")),
+        *(("chain of 3", e, "simulate") for e in ("tumble", "MuJoCo")),
+    }
 
 
 def test_broad_phase_rows_for_both_worlds_and_pairs_in_the_pile():
