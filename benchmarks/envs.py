@@ -1,4 +1,4 @@
-"""Reinforcement-learning environments: tumble's Gymnasium envs beside Gymnasium's MuJoCo ones (issue 29).
+"""Reinforcement-learning environments: tumble's Gymnasium envs beside Gymnasium's MuJoCo ones (issues 29 and 48).
 
 Run from the repository root:
 
@@ -7,8 +7,10 @@ Run from the repository root:
 
 Pairs: ``tumble/CartPole`` beside ``InvertedPendulum-v5`` (a cart-pole in MuJoCo, 2 RK4 steps of 0.02 s per env
 step) and ``tumble/DoublePendulum`` beside ``InvertedDoublePendulum-v5`` (the same robot, 5 RK4 steps of 0.01 s);
-``tumble/Pendulum`` and ``tumble/QuadrotorHover`` alone. Each env takes random actions drawn beforehand (the same
-for both engines' copies), resetting when an episode ends:
+``tumble/Pendulum`` and ``tumble/QuadrotorHover`` alone; the five locomotion tasks ``tumble/Hopper``,
+``tumble/Walker2d``, ``tumble/HalfCheetah``, ``tumble/Ant`` and ``tumble/Humanoid`` beside their ``-v5`` MuJoCo envs
+(the same MJCF files, timesteps and integrators; a tenth of the vector env-steps, as a step costs 10-100 times more).
+Each env takes random actions drawn beforehand (the same for both engines' copies), resetting when an episode ends:
 
 - one env from ``gymnasium.make`` (with its registration's wrappers), steps per second;
 - vector envs of 1, 64 and 1024 copies: tumble's native one (``vectorization_mode="vector_entry_point"``, on 1 and
@@ -16,8 +18,9 @@ for both engines' copies), resetting when an episode ends:
   env-steps (copies × steps) per second.
 
 Ratios: ``x_mujoco_single`` divides a single tumble env's rate by the single MuJoCo env's; ``x_mujoco_vec64`` a
-tumble vector env's by the 64-copy MuJoCo vector env's (the issue's targets: >= 1 and >= 50 at 1024 copies). Every
-timing is the best of ``--repeat`` runs after a first, untimed one (compile, cache load).
+tumble vector env's by the 64-copy MuJoCo vector env's (issue 29's targets: >= 1 and >= 50 at 1024 copies; issue
+48's: one Hopper >= 1, HalfCheetah and Ant at 1024 copies >= 5). Every timing is the best of ``--repeat`` runs after a
+first, untimed one (compile, cache load).
 """
 
 from __future__ import annotations
@@ -33,6 +36,9 @@ __all__ = ["EnvSizes", "FULL", "QUICK", "bench_envs"]
 
 PAIRS = (("tumble/CartPole", "InvertedPendulum-v5"), ("tumble/DoublePendulum", "InvertedDoublePendulum-v5"),
          ("tumble/Pendulum", None), ("tumble/QuadrotorHover", None))  # fmt: skip
+LOCOMOTION = tuple(
+    (f"tumble/{name}", f"{name}-v5") for name in ("Hopper", "Walker2d", "HalfCheetah", "Ant", "Humanoid")
+)
 
 
 @dataclass(frozen=True)
@@ -40,12 +46,14 @@ class EnvSizes:
     single_steps: int = 5000
     vector_copies: tuple = (1, 64, 1024)
     vector_env_steps: int = 200_000  # copies × steps per timed run (20 to 5000 steps)
+    locomotion_env_steps: int = 20_000  # the same for the locomotion tasks
     mujoco_vector_copies: tuple = (1, 64)
     repeat: int = 3
 
 
 FULL = EnvSizes()
-QUICK = EnvSizes(single_steps=20, vector_copies=(1, 4), vector_env_steps=40, mujoco_vector_copies=(1, 4), repeat=1)
+QUICK = EnvSizes(single_steps=20, vector_copies=(1, 4), vector_env_steps=40, locomotion_env_steps=40,
+                 mujoco_vector_copies=(1, 4), repeat=1)  # fmt: skip
 
 
 def _mujoco_available() -> bool:
@@ -103,18 +111,19 @@ def bench_envs(sizes: EnvSizes = FULL, report=None) -> list[dict]:
     mujoco = _mujoco_available()
     cores = max(1, min(2, os.cpu_count() or 1))
     rows = _Rows(report)
-    for ours, theirs in PAIRS:
+    for ours, theirs in PAIRS + LOCOMOTION:
+        env_steps = sizes.locomotion_env_steps if (ours, theirs) in LOCOMOTION else sizes.vector_env_steps
         rows.append(_row(ours, "tumble", "single", 1, 1, _single_rate(ours, sizes.single_steps, sizes.repeat)))
         for copies in sizes.vector_copies:
             for threads in sorted({1, cores}):
                 with integrate.using_threads(threads):
-                    rate = _vector_rate(ours, copies, "vector_entry_point", sizes.vector_env_steps, sizes.repeat)
+                    rate = _vector_rate(ours, copies, "vector_entry_point", env_steps, sizes.repeat)
                 rows.append(_row(ours, "tumble", "vector", copies, threads, rate))
         if theirs is None or not mujoco:
             continue
         rows.append(_row(theirs, "MuJoCo", "single", 1, 1, _single_rate(theirs, sizes.single_steps, sizes.repeat)))
         for copies in sizes.mujoco_vector_copies:
-            rate = _vector_rate(theirs, copies, "sync", sizes.vector_env_steps, sizes.repeat)
+            rate = _vector_rate(theirs, copies, "sync", env_steps, sizes.repeat)
             rows.append(_row(theirs, "MuJoCo", "vector", copies, 1, rate))
     return with_ratios(list(rows))
 
@@ -135,7 +144,7 @@ class _Rows(list):
 def with_ratios(rows: list[dict]) -> list[dict]:
     """Each tumble row of a pair gets its ratio to the MuJoCo single env (single rows) or to the largest MuJoCo
     vector env (vector rows)."""
-    for ours, theirs in PAIRS:
+    for ours, theirs in PAIRS + LOCOMOTION:
         peer = [r for r in rows if r["env"] == theirs]
         if not peer:
             continue

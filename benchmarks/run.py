@@ -37,7 +37,8 @@ Run from the repository root:
 ``batch``        many copies at once: 4096 copies of a tumbling body and 1024 copies of a 10-box pile in a
                  ``tumble.Batch`` beside ``mujoco.rollout`` with the same copies and threads (``benchmarks/batch.py``).
 ``envs``         Gymnasium environments: tumble/CartPole and tumble/DoublePendulum beside InvertedPendulum-v5 and
-                 InvertedDoublePendulum-v5, one env and vector envs of 1, 64 and 1024 copies (``benchmarks/envs.py``).
+                 InvertedDoublePendulum-v5, and the five locomotion tasks beside their -v5 MuJoCo envs, one env
+                 and vector envs of 1, 64 and 1024 copies (``benchmarks/envs.py``).
 ``ensemble``     64 members of the box pile through ``tumble.ensemble.run`` on a local process pool and a Dask
                  LocalCluster with 1 and 2 workers, beside a serial loop: the scaling efficiency
                  (``benchmarks/ensembles.py``).

@@ -82,3 +82,20 @@ def test_damping_goes_through_a_scene_file_and_mjcf(tmp_path):
         w.simulate(0.5, 1 / 240)
     assert copy.joints[0].angular_speed == pytest.approx(joint.angular_speed, rel=1e-12)
     assert rebuilt.joints[0].angular_speed == pytest.approx(joint.angular_speed, rel=1e-9)
+
+
+@pytest.mark.parametrize("dt", [1 / 60, 1 / 240, 1 / 1000])
+def test_an_articulations_implicit_damping_is_mujocos_euler_in_closed_form(dt):
+    """An articulation's ``symplectic_implicit_damping`` step solves ``(I + h b) ω' = I ω``: a damped wheel keeps
+    ``ω₀ (I / (I + h b))ⁿ`` after n steps to round-off, however stiff the damper (``h b / I`` = 3 here at 60 Hz,
+    where the explicit step's factor ``1 - h b / I`` = -2 blows up)."""
+    from tumble.articulation import Articulation, Revolute
+
+    art = Articulation(gravity=(0.0, 0.0, 0.0))
+    bob = art.add_link(Revolute((0.0, 0.0, 1.0)), shape=tumble.Sphere(0.05), mass=2.0, shape_position=(0.5, 0.0, 0.0),
+                       damping=3.0 * INERTIA * 60.0)  # fmt: skip
+    art.set_joint(bob, qd=2.0)
+    b, steps = 3.0 * INERTIA * 60.0, round(0.05 / dt)
+    for _ in range(steps):
+        art.step(dt, integrator="symplectic_implicit_damping")
+    assert art.qd[0] == pytest.approx(2.0 * (INERTIA / (INERTIA + dt * b)) ** steps, rel=1e-12, abs=0.0)

@@ -64,7 +64,7 @@ def test_make_vec_returns_the_native_vector_env(name):
     assert envs.single_action_space == single.action_space
     observations, infos = envs.reset(seed=0)
     assert observations.shape == (3, *single.observation_space.shape)
-    assert observations.dtype == np.float32
+    assert observations.dtype == single.observation_space.dtype
     assert all(observations[c] in single.observation_space for c in range(3))
     results = envs.step(envs.action_space.sample())
     assert results[0].shape == observations.shape
@@ -73,33 +73,32 @@ def test_make_vec_returns_the_native_vector_env(name):
 
 
 @pytest.mark.parametrize("name", NAMES)
-def test_each_vector_copy_equals_a_single_env_stepped_alone(name):
-    """Copies started from the vector env's draws and single envs put in the same states, stepped with the same
-    actions: the same states bit for bit, and the same observations, rewards and terminations, until each copy's
-    episode ends (NumPy's sin and cos may round the last bit differently for arrays of other lengths)."""
+@pytest.mark.parametrize("seed", [3, [7, 1, 7, 40]])
+def test_each_vector_copy_equals_the_single_env_with_its_seed(name, seed):
+    """Gymnasium's ``SyncVectorEnv`` convention: ``reset(seed=s)`` starts copy i as a single env seeded ``s + i``,
+    ``reset(seed=[...])`` as one seeded with its entry; stepped with the same actions, each copy is that env bit for
+    bit (states, observations, rewards, terminations) through its episode and its autoreset's next start."""
     copies = 4
-    envs = make_vector_env(name, copies)
-    envs.reset(seed=3)
-    q, qd = envs.state
-    envs.set_state(q, qd)  # both sides renormalise their quaternions the same way
-    singles = []
-    for c in range(copies):
-        env = make_env(name)
-        env.reset(seed=100 + c)
-        env.set_state(q[c], qd[c])
-        singles.append(env)
-    live = np.ones(copies, dtype=bool)
-    for actions in _actions(envs.action_space, 10, seed=2):
-        vector = envs.step(actions)
-        for c in np.flatnonzero(live):
-            observation, reward, terminated, _, _ = singles[c].step(actions[c])
-            np.testing.assert_array_equal(envs.state[0][c], singles[c].state[0])
-            np.testing.assert_array_equal(envs.state[1][c], singles[c].state[1])
-            np.testing.assert_allclose(vector[0][c], observation, rtol=1e-6, atol=1e-7)
-            assert vector[1][c] == pytest.approx(reward, rel=1e-13, abs=1e-13)
-            assert vector[2][c] == terminated
-            live[c] = not terminated
-    assert np.any(envs.state[0] != q)
+    seeds = [seed + c for c in range(copies)] if isinstance(seed, int) else seed
+    envs = make_vector_env(name, copies, max_episode_steps=6)
+    observations, _ = envs.reset(seed=seed)
+    singles = [make_env(name) for _ in range(copies)]
+    for c, env in enumerate(singles):
+        np.testing.assert_array_equal(observations[c], env.reset(seed=seeds[c])[0])
+    restart = np.zeros(copies, dtype=bool)
+    for actions in _actions(envs.action_space, 9, seed=2):
+        observations, rewards, terminated, truncated, _ = envs.step(actions)
+        for c, env in enumerate(singles):
+            if restart[c]:
+                observation, reward, ended = env.reset()[0], 0.0, False
+            else:
+                observation, reward, ended, _, _ = env.step(actions[c])
+            np.testing.assert_array_equal(envs.state[0][c], env.state[0])
+            np.testing.assert_array_equal(envs.state[1][c], env.state[1])
+            np.testing.assert_array_equal(observations[c], observation)
+            assert rewards[c] == reward and terminated[c] == ended
+        restart = terminated | truncated
+    assert restart.any() or envs._copies.elapsed.max() < 6
 
 
 def test_autoreset_follows_gymnasiums_next_step_mode():
@@ -301,8 +300,12 @@ def test_bad_input_is_refused_with_the_argument_named():
         envs.step(np.array([0, 1, 1]))
     with pytest.raises(ValueError, match=r"actions must be 0 \(push left\) or 1"):
         envs.step(np.array([0, 2]))
-    with pytest.raises(TypeError, match="seed must be None or an int"):
+    with pytest.raises(TypeError, match="seed must be None, an int or a list of 2 ints"):
         envs.reset(seed=1.5)
+    with pytest.raises(ValueError, match="one entry per copy"):
+        envs.reset(seed=[1, 2, 3])
+    with pytest.raises(TypeError, match="seed entries must be ints or None"):
+        envs.reset(seed=[1, "2"])
     with pytest.raises(ValueError, match="reset_mask"):
         envs.reset(options={"reset_mask": np.array([1, 0])})
     env = make_env("DoublePendulum")

@@ -35,7 +35,7 @@ from ..shapes import Shape
 from .actuators import Actuator
 from .collision import Collisions, Geom, pack_geoms, pack_pairs, pair_weights, translation_weight
 from .drives import JointDrives, softness
-from .integrators import EULER, NOT_FINITE, RK4, SYMPLECTIC
+from .integrators import DAMPED, EULER, NOT_FINITE, RK4, SYMPLECTIC
 from .joint_view import ArticulationJoint
 from .joints import Ball, Free, Joint, Prismatic, Revolute
 from .kernels import CONTACTS, FORWARD, INVERSE, KINEMATICS, MASS_MATRIX, PROJECT, SIMULATE, articulation_kernel
@@ -73,7 +73,7 @@ __all__ = [
     "Tendon",
 ]
 
-INTEGRATORS = {"euler": EULER, "symplectic": SYMPLECTIC, "rk4": RK4}
+INTEGRATORS = {"euler": EULER, "symplectic": SYMPLECTIC, "rk4": RK4, "symplectic_implicit_damping": DAMPED}
 LOOP_KINDS = ("point",)
 
 
@@ -579,9 +579,10 @@ class Articulation(JointDrives, Collisions):
     def step(self, dt, tau=None, integrator="symplectic", external=None) -> None:
         """Advance the state by ``dt`` seconds under joint forces ``tau`` (nv,) (default zero).
 
-        ``integrator``: ``"symplectic"`` (semi-implicit Euler), ``"rk4"`` or ``"euler"``. ``external``: optional
-        (n, 6) world-frame rows (force [N] at each link's centre of mass, torque [N m]) held over the step. On a
-        :class:`~tumble.SimulationError` the state stays as it was.
+        ``integrator``: ``"symplectic"`` (semi-implicit Euler), ``"rk4"``, ``"euler"``, or
+        ``"symplectic_implicit_damping"`` (MuJoCo's Euler: the joints' damping implicit, ``integrators.py``).
+        ``external``: optional (n, 6) world-frame rows (force [N] at each link's centre of mass, torque [N m]) held
+        over the step. On a :class:`~tumble.SimulationError` the state stays as it was.
         """
         dt = as_step("dt", dt, self._time)
         method = _check_integrator(integrator)

@@ -15,13 +15,14 @@ from ..dynamics.integrate import thread_pool, threads
 from ..errors import SimulationError
 from .articulation import Articulation, _check_integrator, unit_quaternions
 from .integrators import NOT_FINITE
-from .kernels import batch_kernel
+from .kernels import READOUT_WIDTH, batch_kernel
 from .model import counts, work_size
 
 __all__ = ["ArticulationBatch"]
 
 # Below this many copy-steps a call stays on the calling thread: a hand-off to the pool costs ~20 µs.
 _PARALLEL_MIN_STEPS = 256
+_NO_READOUT = np.zeros((0, 0, READOUT_WIDTH))
 
 
 class ArticulationBatch:
@@ -133,21 +134,24 @@ class ArticulationBatch:
             raise ValueError(f"tau[{bad[0]}, {bad[1]}] must be finite, got {float(self._tau[tuple(bad)])!r}")
         self._advance(dt, steps, method)
 
-    def _advance(self, dt: float, steps: int, method: int) -> None:
-        """:meth:`step` with its arguments already checked (the environments' path: they check their actions)."""
+    def _advance(self, dt: float, steps: int, method: int, copies=None, readout=None) -> None:
+        """:meth:`step` with its arguments already checked (the environments' path: they check their actions), of
+        the copies ``copies`` (int64 indices; all by default). ``readout`` (n, links, ``kernels.READOUT_WIDTH``):
+        each stepped copy's links at the state reached (``kernels.batch_kernel``), for observations."""
+        copies = np.arange(self._n, dtype=np.int64) if copies is None else copies
+        readout = _NO_READOUT if readout is None else readout
         before = (self._q.copy(), self._qd.copy())
-        workers = min(threads(), self._n)
-        if workers < 2 or self._n * steps < _PARALLEL_MIN_STEPS:
+        workers = min(threads(), len(copies))
+        if workers < 2 or len(copies) * max(steps, 1) < _PARALLEL_MIN_STEPS:
             failed = batch_kernel(self._ints, self._reals, self._q, self._qd, self._tau, self._work[0], self._external,
-                                  dt, method, steps, 0, self._n, self._failures)  # fmt: skip
+                                  dt, method, steps, copies, self._failures, readout)  # fmt: skip
         else:
             if self._work.shape[0] < workers:
                 self._work = np.zeros((workers, self._work_size))
-            bounds = np.linspace(0, self._n, workers + 1).astype(np.int64)
             futures = [thread_pool().submit(batch_kernel, self._ints, self._reals, self._q, self._qd, self._tau,
-                                             self._work[k], self._external, dt, method, steps, int(bounds[k]),
-                                             int(bounds[k + 1]), self._failures)
-                       for k in range(workers)]  # fmt: skip
+                                             self._work[k], self._external, dt, method, steps, part, self._failures,
+                                             readout)
+                       for k, part in enumerate(np.array_split(copies, workers))]  # fmt: skip
             failed = sum(f.result() for f in futures)
         if failed:
             raise self._failure(before, failed)

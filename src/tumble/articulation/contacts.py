@@ -29,6 +29,8 @@ from .model import (
     CONTACT_TANGENT,
     DOF_PARENT,
     DOF_TIP,
+    EFC_FORCE,
+    EFC_SCALAR,
     GEOM_LINK,
     GEOM_POS,
     GEOM_QUAT,
@@ -49,7 +51,7 @@ from .model import (
 )
 from .spatial import vec3
 
-__all__ = ["contact_rows", "find_contacts"]
+__all__ = ["contact_rows", "contact_wrenches", "find_contacts"]
 
 
 @inline
@@ -251,3 +253,40 @@ def contact_rows(m, w, found, count, qd, h):
         for _ in range(4):
             count = soft_row(w, count, -1 - c, distance, margin, refs, imps, weight, 0.0, math.inf, h, qd)
     return count
+
+
+@inline
+def contact_wrenches(m, w, out, column):
+    """Add each link's contact wrench (world axes, about the world origin: moment, then force) to ``out[link,
+    column : column + 6]`` from the forces of the last solve; rows past the solve's must hold zero force.
+
+    A contact's force on geom B is ``Σfᵢ n + μ (f₀ - f₁) t₁ + μ (f₂ - f₃) t₂`` over its pyramid's rows (MuJoCo
+    documentation, *Computation*: "Contact"), acting at the contact point; geom A takes the opposite.
+    """
+    e, contacts = w.efc_work, w.contact_work
+    rows = e.shape[1]
+    r = 0
+    while r < rows:
+        scalar = e[EFC_SCALAR, r]
+        if scalar >= 0.0:
+            r += 1
+            continue
+        c = int(-1.0 - scalar)
+        k = int(contacts[c, CONTACT_PAIR])
+        normal = vec3(contacts[c], CONTACT_NORMAL)
+        if m.pair_ints[k, PAIR_CONDIM] == 1 or r + 3 >= rows:
+            force = scale(normal, e[EFC_FORCE, r])
+            r += 1
+        else:
+            f0, f1, f2, f3 = e[EFC_FORCE, r], e[EFC_FORCE, r + 1], e[EFC_FORCE, r + 2], e[EFC_FORCE, r + 3]
+            t1, t2 = _frame(normal, vec3(contacts[c], CONTACT_TANGENT))
+            mu = m.pair_reals[k, PAIR_FRICTION]
+            force = add(scale(normal, f0 + f1 + f2 + f3), add(scale(t1, mu * (f0 - f1)), scale(t2, mu * (f2 - f3))))
+            r += 4
+        moment = cross(vec3(contacts[c], CONTACT_POINT), force)
+        for geom, sign in ((m.pair_ints[k, PAIR_B], 1.0), (m.pair_ints[k, PAIR_A], -1.0)):
+            link = m.geom_ints[geom, GEOM_LINK]
+            if link >= 0:
+                for i in range(3):
+                    out[link, column + i] += sign * moment[i]
+                    out[link, column + 3 + i] += sign * force[i]

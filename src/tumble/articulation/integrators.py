@@ -5,6 +5,9 @@ on the configuration manifold with :func:`~.kinematics.integrate_configuration`,
 
 * ``euler``: ``q ← q ⊕ h q̇₀``, ``q̇ ← q̇₀ + h q̈₀`` (first order; drifts in energy, for teaching).
 * ``symplectic``: ``q̇ ← q̇₀ + h q̈₀`` then ``q ← q ⊕ h q̇`` (first order, bounded energy error).
+* ``symplectic_implicit_damping``: MuJoCo's Euler integrator. ``symplectic``, with the joints' damping ``B``
+  implicit in the velocity update: ``q̈ ← (H + h B)⁻¹ H q̈₀`` before the step (MuJoCo documentation, *Computation*:
+  "Numerical integration"), so a stiff damper stays stable at a long step.
 * ``rk4``: the classical four stages in the Runge–Kutta–Munthe-Kaas form (Munthe-Kaas, "High order
   Runge-Kutta methods on manifolds", 1999): each stage's coordinates are ``q₀ ⊕ θ`` with ``θ`` in the tangent
   space at ``q₀``, and a stage velocity ``ω`` enters as ``dexp⁻¹_θ(ω) ≈ ω + ½ θ × ω + θ × (θ × ω)/12`` for the
@@ -35,6 +38,7 @@ from .loops import loop_jacobian, project_loop_closures, solve_loop_closures
 from .model import (
     BIAS,
     CHART,
+    DAMPING,
     DIAG,
     JOINT,
     Q_START,
@@ -46,11 +50,11 @@ from .model import (
     RHS,
     V_START,
 )
-from .spatial import assign, fill, vec3
+from .spatial import assign, fill, fill_matrix, vec3
 
-__all__ = ["EULER", "NOT_FINITE", "OK", "RK4", "SINGULAR", "SYMPLECTIC", "accelerations", "step"]
+__all__ = ["DAMPED", "EULER", "NOT_FINITE", "OK", "RK4", "SINGULAR", "SYMPLECTIC", "accelerations", "step"]
 
-EULER, SYMPLECTIC, RK4 = 0, 1, 2
+EULER, SYMPLECTIC, RK4, DAMPED = 0, 1, 2, 3
 OK, SINGULAR, NOT_FINITE = 0, 1, 2
 _BALL = int(JointType.BALL)
 _FREE = int(JointType.FREE)
@@ -122,6 +126,35 @@ def _chart_rates(link_ints, v, weight, reach, chart, rate_sum):
             for k in range(3):
                 rate_sum[rotation + k] += weight * rate[k]
                 chart[rotation + k] = reach * rate[k]
+
+
+@inline
+def _implicit_damping(m, w, qdd, h):
+    """``q̈ ← (H + h B)⁻¹ H q̈`` with ``B`` the joints' damping (MuJoCo's ``mj_Euler``; nothing without damping).
+    ``H`` is made again by the CRBA (the kinematics are those of the evaluation) into ``w.mass_matrix``, where the
+    factor of ``H + h B`` is left. Returns -1 or the row of a singular pivot."""
+    dof_params, damped = m.dof_params, False
+    for k in range(qdd.shape[0]):
+        damped = damped or dof_params[k, DAMPING] > 0.0
+    if not damped:
+        return -1
+    matrix, product = w.mass_matrix, w.dof_work[RHS]
+    fill_matrix(matrix, 0.0)
+    crba(m.link_ints, m.dof_ints, dof_params, w.link_work, w.dof_motion, matrix)
+    nv = qdd.shape[0]
+    for j in range(nv):
+        total = 0.0
+        for k in range(nv):
+            total += matrix[j, k] * qdd[k]
+        product[j] = total
+    for k in range(nv):
+        matrix[k, k] += h * dof_params[k, DAMPING]
+    bad = ltdl_factor(m.dof_ints, matrix, w.dof_work[DIAG])
+    if bad >= 0:
+        return bad
+    assign(qdd, product)
+    ltdl_solve(m.dof_ints, matrix, qdd)
+    return -1
 
 
 @inline
@@ -208,6 +241,8 @@ def step(m, w, q, qd, tau, external, use_external, h, method):
                       use_external, qdd)  # fmt: skip
         else:
             bad = accelerations(m, w, q, qd, tau, external, use_external, h)
+        if bad < 0 and method == DAMPED:
+            bad = _implicit_damping(m, w, qdd, h)
         if bad >= 0:
             return SINGULAR, bad
         for k in range(nv):

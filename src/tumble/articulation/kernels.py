@@ -11,14 +11,15 @@ return status codes that the facade turns into errors.
 from __future__ import annotations
 
 from .._jit import inline, kernel
+from ..math3d import add, cross, dot, scale, sub
 from .constraints import applied_forces
-from .contacts import find_contacts
+from .contacts import contact_wrenches, find_contacts
 from .dynamics import crba, joint_energies, rnea
 from .integrators import accelerations, step
 from .kinematics import energies, forward_kinematics
 from .loops import loop_jacobian, project_loop_closures
-from .model import QDD, RHS, model_views, work_views
-from .spatial import assign, fill, fill_matrix
+from .model import EFC_FORCE, INERTIA_WORLD, PARENT, POS, QDD, RHS, VEL, model_views, work_views
+from .spatial import assign, fill, fill_matrix, get3, get6, put3
 
 __all__ = [
     "FORWARD",
@@ -30,9 +31,18 @@ __all__ = [
     "CONTACTS",
     "articulation_kernel",
     "batch_kernel",
+    "READOUT_INERTIA",
+    "READOUT_POINT",
+    "READOUT_VELOCITY",
+    "READOUT_WRENCH",
+    "READOUT_WIDTH",
 ]
 
 KINEMATICS, INVERSE, MASS_MATRIX, FORWARD, PROJECT, SIMULATE, CONTACTS = 0, 1, 2, 3, 4, 5, 6
+# batch_kernel's readout columns, per link (_read_links): MuJoCo's cinert (10), cvel (6) and cfrc_ext (6), and the
+# point they are about (3)
+READOUT_INERTIA, READOUT_VELOCITY, READOUT_WRENCH, READOUT_POINT = 0, 10, 16, 22
+READOUT_WIDTH = 25
 
 
 @inline
@@ -113,9 +123,73 @@ def articulation_kernel(ints, reals, q, qd, vec_in, external, use_external, work
     return steps, 0, -1
 
 
+@inline
+def _read_links(m, w, q, qd, tau, external, h, out):
+    """The links at ``(q, qd)`` under ``tau`` into ``out`` (links, ``READOUT_WIDTH``), as MuJoCo's "com-based"
+    ``cinert``, ``cvel`` and ``cfrc_ext``: world axes, about the centre of mass ``p`` of the link's tree (the links
+    under its base link, MuJoCo's ``subtree_com`` of the body's root), which ``READOUT_POINT`` holds.
+
+    ``cinert`` is ``(I_xx, I_yy, I_zz, I_xy, I_xz, I_yz, m (c - p), m)``, ``cvel`` ``(ω, velocity of the point at p)``,
+    ``cfrc_ext`` ``(moment about p, force)`` of the link's contacts, from a fresh solve at this state. The kinematics
+    give the inertia about the world origin ``(m, h = m c, I_O)``; the parallel-axis theorem written with ``h`` moves
+    it to ``p``: ``I_p = I_O + (m|p|² - 2 h·p) E - (m p pᵀ - h pᵀ - p hᵀ)``.
+    """
+    fill(w.efc_work[EFC_FORCE], 0.0)  # contact_wrenches reads every row: those past this solve's keep no force
+    bad = accelerations(m, w, q, qd, tau, external, False, h)
+    n, link_ints, link_work = out.shape[0], m.link_ints, w.link_work
+    for i in range(n):  # each base link's tree: its mass and first moment, then its centre of mass
+        if link_ints[i, PARENT] >= 0:
+            continue
+        mass, first = 0.0, (0.0, 0.0, 0.0)
+        for j in range(i, n):
+            if _base(link_ints, j) == i:
+                mass += link_work[j, INERTIA_WORLD]
+                first = add(first, get3(link_work, j, INERTIA_WORLD + 1))
+        point = scale(first, 1.0 / mass) if mass > 0.0 else get3(link_work, i, POS)
+        for j in range(i, n):
+            if _base(link_ints, j) == i:
+                put3(out, j, READOUT_POINT, point)
+    for i in range(n):
+        p = get3(out, i, READOUT_POINT)
+        mass = link_work[i, INERTIA_WORLD]
+        first = get3(link_work, i, INERTIA_WORLD + 1)
+        hp, pp = dot(first, p), dot(p, p)
+        k = READOUT_INERTIA
+        for a, b in ((0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2)):
+            shift = mass * p[a] * p[b] - first[a] * p[b] - p[a] * first[b]
+            out[i, k] = link_work[i, INERTIA_WORLD + 4 + k - READOUT_INERTIA] - shift
+            if a == b:
+                out[i, k] += mass * pp - 2.0 * hp
+            k += 1
+        put3(out, i, READOUT_INERTIA + 6, sub(first, scale(p, mass)))
+        out[i, READOUT_INERTIA + 9] = mass
+        velocity = get6(link_work, i, VEL)
+        put3(out, i, READOUT_VELOCITY, velocity[0])
+        put3(out, i, READOUT_VELOCITY + 3, add(velocity[1], cross(velocity[0], p)))
+        for k in range(6):
+            out[i, READOUT_WRENCH + k] = 0.0
+    if bad < 0 and m.pair_ints.shape[0] > 0:
+        contact_wrenches(m, w, out, READOUT_WRENCH)  # about the world origin: moved to p below
+        for i in range(n):
+            moment = sub(
+                get3(out, i, READOUT_WRENCH), cross(get3(out, i, READOUT_POINT), get3(out, i, READOUT_WRENCH + 3))
+            )
+            put3(out, i, READOUT_WRENCH, moment)
+    return bad
+
+
+@inline
+def _base(link_ints, i):
+    """The base link (no parent) of link ``i``'s tree."""
+    while link_ints[i, PARENT] >= 0:
+        i = link_ints[i, PARENT]
+    return i
+
+
 @kernel
-def batch_kernel(ints, reals, q, qd, tau, work, external, h, method, steps, first, last, failures):  # fmt: skip
-    """``steps`` time steps of copies ``first..last-1`` of one articulation (``ArticulationBatch``); releases the GIL.
+def batch_kernel(ints, reals, q, qd, tau, work, external, h, method, steps, copies, failures, readout):  # fmt: skip
+    """``steps`` time steps of the copies ``copies`` (indices) of one articulation (``ArticulationBatch``); releases
+    the GIL.
 
     Args:
         ints, reals: the shared model buffers; work: one work buffer (``model.work_size``) for this call's copies.
@@ -123,6 +197,8 @@ def batch_kernel(ints, reals, q, qd, tau, work, external, h, method, steps, firs
             over the steps. external: (n, 6) zeros (no external loads).
         failures: (copies, 3) int64: ``(step, status, where)`` of each copy's failing step, written only for a
             copy that fails (it stops there with its state from before that step).
+        readout: (copies, links, ``READOUT_WIDTH``), or no rows: after its steps, each copy's links as
+            :func:`_read_links` reads them at the state reached (for observations: the environments).
 
     Returns the number of copies that failed. A copy's arithmetic is :func:`articulation_kernel`'s (the same
     ``step``), so each copy advances bit for bit as the articulation alone: a step reads nothing of the work
@@ -131,12 +207,18 @@ def batch_kernel(ints, reals, q, qd, tau, work, external, h, method, steps, firs
     m = model_views(ints, reals)
     w = work_views(work, ints[0], ints[1], ints[2], ints[3], ints[4], ints[8], ints[6])
     failed = 0
-    for c in range(first, last):
+    for c in copies:
         q_c, qd_c, tau_c = q[c], qd[c], tau[c]
+        status, where = 0, -1
         for n in range(steps):
             status, where = step(m, w, q_c, qd_c, tau_c, external, False, h, method)
             if status != 0:
                 failures[c, 0], failures[c, 1], failures[c, 2] = n, status, where
                 failed += 1
                 break
+        if status == 0 and readout.shape[0] > 0:
+            bad = _read_links(m, w, q_c, qd_c, tau_c, external, h, readout[c])
+            if bad >= 0:
+                failures[c, 0], failures[c, 1], failures[c, 2] = steps, 1, bad
+                failed += 1
     return failed

@@ -24,6 +24,7 @@ except ImportError as error:  # pragma: no cover - the extra is missing
 from .cartpole import CartPoleTask
 from .core import Task, TumbleEnv, TumbleVectorEnv
 from .double_pendulum import DoublePendulumTask
+from .locomotion import AntTask, HalfCheetahTask, HopperTask, HumanoidTask, Walker2dTask
 from .pendulum import PendulumTask
 from .quadrotor import QuadrotorHoverTask
 
@@ -34,23 +35,31 @@ TASKS = {
     "Pendulum": PendulumTask,
     "DoublePendulum": DoublePendulumTask,
     "QuadrotorHover": QuadrotorHoverTask,
+    "Hopper": HopperTask,
+    "Walker2d": Walker2dTask,
+    "HalfCheetah": HalfCheetahTask,
+    "Ant": AntTask,
+    "Humanoid": HumanoidTask,
 }
 
 
-def make_env(task: str, render_mode=None) -> TumbleEnv:
-    """The single environment of ``task`` (a key of :data:`TASKS`), without Gymnasium's wrappers."""
-    return TumbleEnv(_task(task), render_mode=render_mode)
+def make_env(task: str, render_mode=None, **task_arguments) -> TumbleEnv:
+    """The single environment of ``task`` (a key of :data:`TASKS`), without Gymnasium's wrappers;
+    ``task_arguments`` go to the task (the locomotion tasks take Gymnasium's v5 constructor arguments)."""
+    return TumbleEnv(_task(task, task_arguments), render_mode=render_mode)
 
 
-def make_vector_env(task: str, num_envs: int, max_episode_steps=None, render_mode=None) -> TumbleVectorEnv:
+def make_vector_env(task: str, num_envs: int, max_episode_steps=None, render_mode=None,
+                    **task_arguments) -> TumbleVectorEnv:  # fmt: skip
     """``num_envs`` copies of ``task`` as one vector environment."""
-    return TumbleVectorEnv(_task(task), num_envs, max_episode_steps=max_episode_steps, render_mode=render_mode)
+    return TumbleVectorEnv(_task(task, task_arguments), num_envs, max_episode_steps=max_episode_steps,
+                           render_mode=render_mode)  # fmt: skip
 
 
-def _task(task: str):
+def _task(task: str, arguments: dict):
     if task not in TASKS:
         raise ValueError(f"task must be one of {tuple(TASKS)}, got {task!r}")
-    return TASKS[task]()
+    return TASKS[task](**arguments)
 
 
 def _register() -> None:
@@ -63,11 +72,12 @@ def _register() -> None:
 
 
 def _entry_points(name: str):
-    def single(render_mode=None):
-        return make_env(name, render_mode=render_mode)
+    def single(render_mode=None, **task_arguments):
+        return make_env(name, render_mode=render_mode, **task_arguments)
 
-    def vector(num_envs=1, max_episode_steps=None, render_mode=None):
-        return make_vector_env(name, num_envs, max_episode_steps=max_episode_steps, render_mode=render_mode)
+    def vector(num_envs=1, max_episode_steps=None, render_mode=None, **task_arguments):
+        return make_vector_env(name, num_envs, max_episode_steps=max_episode_steps, render_mode=render_mode,
+                               **task_arguments)  # fmt: skip
 
     return single, vector
 

@@ -62,9 +62,9 @@ class CartPoleTask(Task):
         art.add_link(Revolute((0.0, 1.0, 0.0)), parent=cart, mass_properties=pole, name="pole")
         return art
 
-    def initial_state(self, rng, count):
-        start = rng.uniform(-0.05, 0.05, size=(count, 4))  # (x, ẋ, θ, θ̇) of each copy
-        return start[:, 0::2], start[:, 1::2]
+    def initial_state(self, rng):
+        start = rng.uniform(-0.05, 0.05, size=4)  # (x, ẋ, θ, θ̇)
+        return start[0::2], start[1::2]
 
     def prepare(self, actions, q, qd, tau):
         pushes = np.asarray(actions).reshape(-1)
@@ -76,7 +76,7 @@ class CartPoleTask(Task):
             raise ValueError(f"actions must be 0 (push left) or 1 (push right), got {actions!r}") from None
         return pushes
 
-    def observe(self, q, qd):
+    def observe(self, q, qd, links=None, tau=None):
         observations = np.empty((q.shape[0], 4), dtype=np.float32)
         observations[:, 0::2], observations[:, 1::2] = q, qd
         return observations

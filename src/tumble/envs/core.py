@@ -7,9 +7,10 @@ task turns actions into joint forces, observations, rewards and terminations wit
 axis, and the batch takes the physics steps of one control step in one compiled call. So a copy of a vector env is
 bit for bit the single env with the same seed and actions.
 
-Seeds: ``reset(seed=s)`` seeds the environment's one generator (``gymnasium.utils.seeding.np_random(s)``), from which
-a vector env draws the starts of all the copies it resets at once (as Gymnasium's own vector ``CartPole`` does):
-the same seed gives the same episodes. Autoreset is Gymnasium 1.x's default,
+Seeds follow Gymnasium's ``SyncVectorEnv``: each copy has its own generator, and ``reset(seed=s)`` seeds copy ``i``
+as a single env seeded ``s + i`` (``gymnasium.utils.seeding.np_random(s + i)``), ``reset(seed=[s0, s1, ...])`` copy
+``i`` with ``si``; a copy's later starts come from its generator. So every copy equals the single env with its seed,
+bit for bit. Autoreset is Gymnasium 1.x's default,
 ``AutoresetMode.NEXT_STEP``: the step after a copy's episode ends resets that copy and returns its first
 observation with reward 0, ignoring its action.
 """
@@ -27,6 +28,7 @@ from gymnasium.vector.utils import batch_space
 from .._validate import as_array
 from ..articulation import Articulation, ArticulationBatch
 from ..articulation.articulation import INTEGRATORS
+from ..articulation.kernels import READOUT_WIDTH
 
 __all__ = ["Task", "TumbleEnv", "TumbleVectorEnv"]
 
@@ -46,6 +48,7 @@ class Task:
     integrator: str
     max_episode_steps: int
     reward_reads_start = False  # whether reward() reads the state before the step (else it gets None)
+    reads_links = False  # whether observe() and outcome() read the links' readout (else they get None)
     observation_space: gym.Space
     action_space: gym.Space
 
@@ -53,9 +56,8 @@ class Task:
         """The robot, built fresh."""
         raise NotImplementedError
 
-    def initial_state(self, rng: np.random.Generator, count: int) -> tuple[np.ndarray, np.ndarray]:
-        """``(q, qd)``, (count, nq) and (count, nv), of ``count`` copies starting an episode, drawn from ``rng`` copy
-        after copy (row 0's numbers first)."""
+    def initial_state(self, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
+        """``(q, qd)``, (nq,) and (nv,), of a copy starting an episode, drawn from its generator ``rng``."""
         raise NotImplementedError
 
     def prepare(self, actions: np.ndarray, q: np.ndarray, qd: np.ndarray, tau: np.ndarray) -> np.ndarray:
@@ -63,14 +65,28 @@ class Task:
         act (clipped to the action space), which :meth:`reward` receives."""
         raise NotImplementedError
 
-    def observe(self, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
-        """(copies, observation size) float32."""
+    def observe(self, q: np.ndarray, qd: np.ndarray, links=None, tau=None) -> np.ndarray:
+        """(copies, observation size) in the observation space's dtype. ``links``: (copies, links,
+        ``READOUT_WIDTH``) the links' inertia, velocity and contact wrench at ``(q, qd)`` if ``reads_links``;
+        ``tau``: (copies, nv) the joint forces of the step that reached it (zero at a start)."""
         raise NotImplementedError
 
     def reward(self, q0, qd0, actions, q, qd, terminated) -> np.ndarray:
         """(copies,) the reward of a step from ``(q0, qd0)`` (``None`` unless ``reward_reads_start``) to ``(q, qd)``
         under ``actions`` (as they acted)."""
         raise NotImplementedError
+
+    def outcome(self, start, actions, q, qd, links) -> tuple[np.ndarray, np.ndarray, dict]:
+        """``(rewards (copies,), terminated (copies,), info)`` of a step from ``start`` (``(q0, qd0, links0)``, or
+        ``None`` unless ``reward_reads_start``) to ``(q, qd, links)``; ``info`` maps each key to (copies, ...)
+        values. By default :meth:`terminated`, :meth:`reward`'s rewards and no info."""
+        q0, qd0 = (None, None) if start is None else start[:2]
+        terminated = self.terminated(q, qd)
+        return self.reward(q0, qd0, actions, q, qd, terminated), terminated, {}
+
+    def reset_info(self, q: np.ndarray, qd: np.ndarray, links=None) -> dict:
+        """``info`` of copies starting an episode at ``(q, qd)``: key to (copies, ...) values (none by default)."""
+        return {}
 
     def terminated(self, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
         """(copies,) bool: the episode ended (fell, left the arena)."""
@@ -98,21 +114,47 @@ def _check_episode_steps(max_episode_steps, default: int) -> int:
 
 
 class _Copies:
-    """The copies' physics and episode clocks: what the single and the vector env share."""
+    """The copies' physics, generators and episode clocks: what the single and the vector env share."""
 
     def __init__(self, task: Task, n: int) -> None:
         self.task = task
-        self.batch = ArticulationBatch(task.articulation(), n)
-        self.rng: np.random.Generator | None = None
+        articulation = task.articulation()
+        self.batch = ArticulationBatch(articulation, n)
+        self.rngs: list[np.random.Generator | None] = [None] * n
         self.elapsed = np.zeros(n, dtype=np.int64)
+        self.links = np.zeros((n, len(articulation.links), READOUT_WIDTH)) if task.reads_links else None
         self._method = INTEGRATORS[task.integrator]
         self._h = task.dt / task.substeps
 
+    @property
+    def seeded(self) -> bool:
+        return all(rng is not None for rng in self.rngs)
+
+    def seed(self, which: np.ndarray, seeds) -> None:
+        """New generators for copies ``which`` (indices) from ``seeds`` (an int or None each)."""
+        for i, seed in zip(which, seeds, strict=True):
+            self.rngs[i], _ = seeding.np_random(seed)
+
     def reset(self, which: np.ndarray) -> None:
-        """Start new episodes in copies ``which`` (indices), drawn from the generator."""
-        q, qd = self.task.initial_state(self.rng, len(which))
-        self.batch.q[which], self.batch.qd[which] = q, qd
+        """Start new episodes in copies ``which`` (int64 indices), each drawn from its own generator; their joint
+        forces are zero until the next step, and their links are read at the start if the task reads them."""
+        batch = self.batch
+        for i in which:
+            batch.q[i], batch.qd[i] = self.task.initial_state(self.rngs[i])
+        batch.tau[which] = 0.0
         self.elapsed[which] = 0
+        if self.links is not None:
+            batch._advance(self._h, 0, self._method, copies=which, readout=self.links)
+
+    def observe(self, which=slice(None)) -> np.ndarray:
+        batch = self.batch
+        links = None if self.links is None else self.links[which]
+        return self.task.observe(batch.q[which], batch.qd[which], links, batch.tau[which])
+
+    def reset_info(self, which) -> dict:
+        batch = self.batch
+        links = None if self.links is None else self.links[which]
+        return self.task.reset_info(batch.q[which], batch.qd[which], links)
 
     def set_state(self, which, q, qd) -> None:
         """Put copies ``which`` (an index, or a slice of all) at ``(q, qd)``: validated, quaternions renormalised,
@@ -125,17 +167,21 @@ class _Copies:
         new_q[which], new_qd[which] = q, qd
         batch.q = new_q
         batch.qd = new_qd
+        if self.links is not None:
+            copies = np.arange(batch.n, dtype=np.int64)[which]
+            batch._advance(self._h, 0, self._method, copies=np.atleast_1d(copies), readout=self.links)
 
-    def step(self, actions: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        """One control step of every copy: ``(observations, rewards, terminated, elapsed steps)``."""
+    def step(self, actions: np.ndarray):
+        """One control step of every copy: ``(observations, rewards, terminated, elapsed steps, info)``."""
         task, batch = self.task, self.batch
-        q0, qd0 = (batch.q.copy(), batch.qd.copy()) if task.reward_reads_start else (None, None)
+        start = None
+        if task.reward_reads_start:
+            start = (batch.q.copy(), batch.qd.copy(), None if self.links is None else self.links.copy())
         acting = task.prepare(actions, batch.q, batch.qd, batch.tau)
-        batch._advance(self._h, task.substeps, self._method)
+        batch._advance(self._h, task.substeps, self._method, readout=self.links)
         self.elapsed += 1
-        terminated = task.terminated(batch.q, batch.qd)
-        rewards = task.reward(q0, qd0, acting, batch.q, batch.qd, terminated)
-        return task.observe(batch.q, batch.qd), rewards, terminated, self.elapsed
+        rewards, terminated, info = task.outcome(start, acting, batch.q, batch.qd, self.links)
+        return self.observe(), rewards, terminated, self.elapsed, info
 
 
 class TumbleEnv(gym.Env):
@@ -161,15 +207,14 @@ class TumbleEnv(gym.Env):
 
     def reset(self, *, seed=None, options=None):
         super().reset(seed=seed)
-        self._copies.rng = self.np_random
+        self._copies.rngs[0] = self.np_random
         self._copies.reset(np.zeros(1, dtype=np.int64))
-        batch = self._copies.batch
-        return self.task.observe(batch.q, batch.qd)[0], {}
+        return self._copies.observe()[0], _first(self._copies.reset_info(slice(0, 1)))
 
     def step(self, action):
         actions = np.asarray(action)[None]
-        observations, rewards, terminated, _ = self._copies.step(actions)
-        return observations[0], float(rewards[0]), bool(terminated[0]), False, {}
+        observations, rewards, terminated, _, info = self._copies.step(actions)
+        return observations[0], float(rewards[0]), bool(terminated[0]), False, _first(info)
 
     def render(self):
         if self.render_mode is None:
@@ -213,43 +258,92 @@ class TumbleVectorEnv(VectorEnv):
         self._copies.set_state(slice(None), q, qd)
 
     def reset(self, *, seed=None, options=None):
-        which = np.arange(self.num_envs)
+        which = np.arange(self.num_envs, dtype=np.int64)
         if options is not None and "reset_mask" in options:
             mask = np.asarray(options["reset_mask"])
             if mask.dtype != np.bool_ or mask.shape != (self.num_envs,):
                 raise ValueError(f"options['reset_mask'] must be a bool array of shape ({self.num_envs},), "
                                  f"got {mask.dtype} {mask.shape}")  # fmt: skip
-            which = np.flatnonzero(mask)
-        if seed is not None or self._copies.rng is None:
-            if isinstance(seed, bool) or not (seed is None or isinstance(seed, numbers.Integral)):
-                raise TypeError(f"seed must be None or an int, got {seed!r}")
-            self._copies.rng, _ = seeding.np_random(None if seed is None else int(seed))
-        self._copies.reset(which)
+            which = np.flatnonzero(mask).astype(np.int64)
+        seeds = self._seeds(seed)
+        copies = self._copies
+        unseeded = [i for i in which if copies.rngs[i] is None]
+        if seed is not None:
+            copies.seed(which, [seeds[i] for i in which])
+        elif unseeded:
+            copies.seed(unseeded, [None] * len(unseeded))
+        copies.reset(which)
         self._autoreset[which] = False
-        batch = self._copies.batch
-        return self.task.observe(batch.q, batch.qd), {}
+        return copies.observe(), _merge_info({}, copies.reset_info(which), which, self.num_envs)
+
+    def _seeds(self, seed) -> list:
+        """One seed (or None) per copy from ``reset``'s ``seed``: ``s + i`` from an int, a list as given."""
+        n = self.num_envs
+        if seed is None:
+            return [None] * n
+        if isinstance(seed, numbers.Integral) and not isinstance(seed, bool):
+            return [int(seed) + i for i in range(n)]
+        if isinstance(seed, (list, tuple, np.ndarray)):
+            seeds = list(seed)
+            if len(seeds) != n:
+                raise ValueError(f"seed must have one entry per copy ({n}), got {len(seeds)}")
+            for entry in seeds:
+                if entry is not None and (isinstance(entry, bool) or not isinstance(entry, numbers.Integral)):
+                    raise TypeError(f"seed entries must be ints or None, got {entry!r}")
+            return [None if entry is None else int(entry) for entry in seeds]
+        raise TypeError(f"seed must be None, an int or a list of {n} ints, got {seed!r}")
 
     def step(self, actions):
-        if self._copies.rng is None:
+        if not self._copies.seeded:
             raise RuntimeError("call reset() before step()")
         actions = np.asarray(actions)
         if actions.ndim == 0 or actions.shape[0] != self.num_envs:
             raise ValueError(f"actions must have {self.num_envs} rows (one per copy), got shape {actions.shape}")
-        restarting = np.flatnonzero(self._autoreset)
-        observations, rewards, terminated, elapsed = self._copies.step(actions)
+        restarting = np.flatnonzero(self._autoreset).astype(np.int64)
+        copies = self._copies
+        observations, rewards, terminated, elapsed, info = copies.step(actions)
         truncated = elapsed >= self.max_episode_steps
+        infos = _masked(info, ~self._autoreset)
         if len(restarting):
-            self._copies.reset(restarting)
-            batch = self._copies.batch
-            observations[restarting] = self.task.observe(batch.q[restarting], batch.qd[restarting])
+            copies.reset(restarting)
+            observations[restarting] = copies.observe(restarting)
             rewards[restarting] = 0.0
             terminated[restarting] = False
             truncated[restarting] = False
+            _merge_info(infos, copies.reset_info(restarting), restarting, self.num_envs)
         self._autoreset = terminated | truncated
-        return observations, rewards, terminated, truncated, {}
+        return observations, rewards, terminated, truncated, infos
 
     def render(self):
         if self.render_mode is None:
             gym.logger.warn("render() called without a render_mode: make the environment with render_mode='rgb_array'")
             return None
         return tuple(self.task.draw(q) for q in self._copies.batch.q)
+
+
+def _first(info: dict) -> dict:
+    """A single env's ``info`` from the copies' (one copy): scalars as NumPy scalars, arrays as arrays."""
+    return {key: values[0] for key, values in info.items()}
+
+
+def _masked(info: dict, mask: np.ndarray) -> dict:
+    """Gymnasium's vector ``info`` from every copy's values (``info``, each (n, ...)), kept where ``mask`` is true:
+    each key beside its mask ``_key``."""
+    infos: dict = {}
+    for key, values in info.items():
+        infos[key] = np.where(mask.reshape(-1, *([1] * (np.ndim(values) - 1))), values, 0)
+        infos[f"_{key}"] = mask.copy()
+    return infos
+
+
+def _merge_info(infos: dict, info: dict, which: np.ndarray, n: int) -> dict:
+    """Put the values of copies ``which`` (``info``, each (len(which), ...)) into the vector ``infos`` of ``n``
+    copies, their masks set; returns ``infos``."""
+    for key, values in info.items():
+        values = np.asarray(values)
+        if key not in infos:
+            infos[key] = np.zeros((n, *values.shape[1:]), dtype=values.dtype)
+            infos[f"_{key}"] = np.zeros(n, dtype=bool)
+        infos[key][which] = values
+        infos[f"_{key}"][which] = True
+    return infos

@@ -72,15 +72,15 @@ class DoublePendulumTask(Task):
                      shape_position=(0.0, 0.0, POLE / 2), damping=DAMPING, name="pole2")  # fmt: skip
         return art
 
-    def initial_state(self, rng, count):
-        return rng.uniform(-0.1, 0.1, size=(count, 3)), 0.1 * rng.standard_normal((count, 3))
+    def initial_state(self, rng):
+        return rng.uniform(-0.1, 0.1, size=3), 0.1 * rng.standard_normal(3)
 
     def prepare(self, actions, q, qd, tau):
         pushes = np.clip(np.asarray(actions, dtype=np.float64).reshape(q.shape[0], 1)[:, 0], -1.0, 1.0)
         tau[:, 0] = GEAR * pushes
         return pushes
 
-    def observe(self, q, qd):
+    def observe(self, q, qd, links=None, tau=None):
         angles = q[:, 1:]
         return np.concatenate([q[:, :1], portable.sin(angles), portable.cos(angles), np.clip(qd, -10.0, 10.0)],
                               axis=1).astype(np.float32)  # fmt: skip

@@ -57,16 +57,16 @@ class PendulumTask(Task):
         art.add_link(Revolute((0.0, 1.0, 0.0)), mass_properties=mass, name="rod")
         return art
 
-    def initial_state(self, rng, count):
-        start = rng.uniform((-math.pi, -1.0), (math.pi, 1.0), size=(count, 2))  # (θ, θ̇) of each copy
-        return start[:, :1], start[:, 1:]
+    def initial_state(self, rng):
+        start = rng.uniform((-math.pi, -1.0), (math.pi, 1.0), size=2)  # (θ, θ̇)
+        return start[:1], start[1:]
 
     def prepare(self, actions, q, qd, tau):
         torques = np.clip(np.asarray(actions, dtype=np.float64).reshape(q.shape[0], 1), -MAX_TORQUE, MAX_TORQUE)
         tau[:, 0] = torques[:, 0]
         return torques[:, 0]
 
-    def observe(self, q, qd):
+    def observe(self, q, qd, links=None, tau=None):
         return np.stack([portable.cos(q[:, 0]), portable.sin(q[:, 0]), qd[:, 0]], axis=1).astype(np.float32)
 
     def reward(self, q0, qd0, actions, q, qd, terminated):

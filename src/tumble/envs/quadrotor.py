@@ -84,12 +84,12 @@ class QuadrotorHoverTask(Task):
         art.add_link(Free(), mass_properties=body, name="body")
         return art
 
-    def initial_state(self, rng, count):
-        # each copy's position, rotation vector, velocity and body rates, in that order
+    def initial_state(self, rng):
+        # position, rotation vector, velocity and body rates, in that order
         low, high = np.repeat((-0.5, -0.2, -0.5, -0.2), 3), np.repeat((0.5, 0.2, 0.5, 0.2), 3)
-        start = rng.uniform(low, high, size=(count, 12))
-        quat = quat_from_rotvec(start[:, 3:6]).reshape(count, 4)
-        return np.concatenate([start[:, :3], quat], axis=1), start[:, 6:]
+        start = rng.uniform(low, high, size=12)
+        quat = quat_from_rotvec(start[3:6]).reshape(4)
+        return np.concatenate([start[:3], quat]), start[6:]
 
     def rotor_speeds(self, actions) -> np.ndarray:
         """(copies, 4) [rad/s] of actions in [-1, 1] (clipped)."""
@@ -109,7 +109,7 @@ class QuadrotorHoverTask(Task):
         tau[:, 3:] = wrench[:, 1:]
         return actions
 
-    def observe(self, q, qd):
+    def observe(self, q, qd, links=None, tau=None):
         return np.concatenate([q[:, :3], qd[:, :3], q[:, 3:7], qd[:, 3:]], axis=1).astype(np.float32)
 
     def reward(self, q0, qd0, actions, q, qd, terminated):
