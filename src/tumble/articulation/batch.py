@@ -137,7 +137,8 @@ class ArticulationBatch:
     def _advance(self, dt: float, steps: int, method: int, copies=None, readout=None) -> None:
         """:meth:`step` with its arguments already checked (the environments' path: they check their actions), of
         the copies ``copies`` (int64 indices; all by default). ``readout`` (n, links, ``kernels.READOUT_WIDTH``):
-        each stepped copy's links at the state reached (``kernels.batch_kernel``), for observations."""
+        each copy's links at the last evaluation of its step, or at its state with ``steps`` 0
+        (``kernels.batch_kernel``), for observations."""
         copies = np.arange(self._n, dtype=np.int64) if copies is None else copies
         readout = _NO_READOUT if readout is None else readout
         before = (self._q.copy(), self._qd.copy())

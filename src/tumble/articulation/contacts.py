@@ -258,13 +258,13 @@ def contact_rows(m, w, found, count, qd, h):
 @inline
 def contact_wrenches(m, w, out, column):
     """Add each link's contact wrench (world axes, about the world origin: moment, then force) to ``out[link,
-    column : column + 6]`` from the forces of the last solve; rows past the solve's must hold zero force.
+    column : column + 6]`` from the forces of the last solve (its ``w.efc_count`` rows).
 
     A contact's force on geom B is ``Σfᵢ n + μ (f₀ - f₁) t₁ + μ (f₂ - f₃) t₂`` over its pyramid's rows (MuJoCo
     documentation, *Computation*: "Contact"), acting at the contact point; geom A takes the opposite.
     """
     e, contacts = w.efc_work, w.contact_work
-    rows = e.shape[1]
+    rows = int(w.efc_count[0])
     r = 0
     while r < rows:
         scalar = e[EFC_SCALAR, r]
@@ -274,7 +274,7 @@ def contact_wrenches(m, w, out, column):
         c = int(-1.0 - scalar)
         k = int(contacts[c, CONTACT_PAIR])
         normal = vec3(contacts[c], CONTACT_NORMAL)
-        if m.pair_ints[k, PAIR_CONDIM] == 1 or r + 3 >= rows:
+        if m.pair_ints[k, PAIR_CONDIM] == 1:
             force = scale(normal, e[EFC_FORCE, r])
             r += 1
         else:

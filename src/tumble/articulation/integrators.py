@@ -93,6 +93,7 @@ def accelerations(m, w, q, qd, tau, external, use_external, step_size):
         if m.pair_ints.shape[0] > 0:
             count = contact_rows(m, w, find_contacts(m, w), count, qd, step_size)
         solve_constraints(m, w, count, h, qdd)
+        w.efc_count[0] = count
     if m.loop_ints.shape[0] > 0:
         loop_jacobian(link_ints, m.dof_ints, m.loop_ints, m.loop_reals, link_work, dof_motion, w.loop_jac,
                       w.loop_work)  # fmt: skip

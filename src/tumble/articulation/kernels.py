@@ -18,7 +18,7 @@ from .dynamics import crba, joint_energies, rnea
 from .integrators import accelerations, step
 from .kinematics import energies, forward_kinematics
 from .loops import loop_jacobian, project_loop_closures
-from .model import EFC_FORCE, INERTIA_WORLD, PARENT, POS, QDD, RHS, VEL, model_views, work_views
+from .model import INERTIA_WORLD, PARENT, POS, QDD, RHS, VEL, model_views, work_views
 from .spatial import assign, fill, fill_matrix, get3, get6, put3
 
 __all__ = [
@@ -32,6 +32,7 @@ __all__ = [
     "articulation_kernel",
     "batch_kernel",
     "READOUT_INERTIA",
+    "READOUT_ORIGIN",
     "READOUT_POINT",
     "READOUT_VELOCITY",
     "READOUT_WRENCH",
@@ -39,10 +40,10 @@ __all__ = [
 ]
 
 KINEMATICS, INVERSE, MASS_MATRIX, FORWARD, PROJECT, SIMULATE, CONTACTS = 0, 1, 2, 3, 4, 5, 6
-# batch_kernel's readout columns, per link (_read_links): MuJoCo's cinert (10), cvel (6) and cfrc_ext (6), and the
-# point they are about (3)
-READOUT_INERTIA, READOUT_VELOCITY, READOUT_WRENCH, READOUT_POINT = 0, 10, 16, 22
-READOUT_WIDTH = 25
+# batch_kernel's readout columns, per link (_read_links): MuJoCo's cinert (10), cvel (6) and cfrc_ext (6), the point
+# they are about (3) and the link frame's origin (3)
+READOUT_INERTIA, READOUT_VELOCITY, READOUT_WRENCH, READOUT_POINT, READOUT_ORIGIN = 0, 10, 16, 22, 25
+READOUT_WIDTH = 28
 
 
 @inline
@@ -124,18 +125,20 @@ def articulation_kernel(ints, reals, q, qd, vec_in, external, use_external, work
 
 
 @inline
-def _read_links(m, w, q, qd, tau, external, h, out):
-    """The links at ``(q, qd)`` under ``tau`` into ``out`` (links, ``READOUT_WIDTH``), as MuJoCo's "com-based"
-    ``cinert``, ``cvel`` and ``cfrc_ext``: world axes, about the centre of mass ``p`` of the link's tree (the links
-    under its base link, MuJoCo's ``subtree_com`` of the body's root), which ``READOUT_POINT`` holds.
+def _read_links(m, w, q, qd, tau, external, h, out, evaluate):
+    """The links at the last evaluation of the dynamics into ``out`` (links, ``READOUT_WIDTH``), as MuJoCo's
+    "com-based" ``cinert``, ``cvel`` and ``cfrc_ext``: world axes, about the centre of mass ``p`` of the link's tree
+    (the links under its base link, MuJoCo's ``subtree_com`` of the body's root), which ``READOUT_POINT`` holds, with
+    the link frame's origin (MuJoCo's ``xpos`` of a body whose joint sits at its origin) in ``READOUT_ORIGIN``.
 
     ``cinert`` is ``(I_xx, I_yy, I_zz, I_xy, I_xz, I_yz, m (c - p), m)``, ``cvel`` ``(ω, velocity of the point at p)``,
-    ``cfrc_ext`` ``(moment about p, force)`` of the link's contacts, from a fresh solve at this state. The kinematics
-    give the inertia about the world origin ``(m, h = m c, I_O)``; the parallel-axis theorem written with ``h`` moves
-    it to ``p``: ``I_p = I_O + (m|p|² - 2 h·p) E - (m p pᵀ - h pᵀ - p hᵀ)``.
+    ``cfrc_ext`` ``(moment about p, force)`` of the link's contacts. The evaluation is the step's last (an RK4 step's
+    fourth stage, an Euler step's start), as MuJoCo's ``mjData`` holds them after ``mj_step``; with ``evaluate``
+    (no step taken), a fresh one at ``(q, qd)`` under ``tau``. The kinematics give the inertia about the world
+    origin ``(m, h = m c, I_O)``; the parallel-axis theorem written with ``h`` moves it to ``p``:
+    ``I_p = I_O + (m|p|² - 2 h·p) E - (m p pᵀ - h pᵀ - p hᵀ)``.
     """
-    fill(w.efc_work[EFC_FORCE], 0.0)  # contact_wrenches reads every row: those past this solve's keep no force
-    bad = accelerations(m, w, q, qd, tau, external, False, h)
+    bad = accelerations(m, w, q, qd, tau, external, False, h) if evaluate else -1
     n, link_ints, link_work = out.shape[0], m.link_ints, w.link_work
     for i in range(n):  # each base link's tree: its mass and first moment, then its centre of mass
         if link_ints[i, PARENT] >= 0:
@@ -166,6 +169,7 @@ def _read_links(m, w, q, qd, tau, external, h, out):
         velocity = get6(link_work, i, VEL)
         put3(out, i, READOUT_VELOCITY, velocity[0])
         put3(out, i, READOUT_VELOCITY + 3, add(velocity[1], cross(velocity[0], p)))
+        put3(out, i, READOUT_ORIGIN, get3(link_work, i, POS))
         for k in range(6):
             out[i, READOUT_WRENCH + k] = 0.0
     if bad < 0 and m.pair_ints.shape[0] > 0:
@@ -198,7 +202,8 @@ def batch_kernel(ints, reals, q, qd, tau, work, external, h, method, steps, copi
         failures: (copies, 3) int64: ``(step, status, where)`` of each copy's failing step, written only for a
             copy that fails (it stops there with its state from before that step).
         readout: (copies, links, ``READOUT_WIDTH``), or no rows: after its steps, each copy's links as
-            :func:`_read_links` reads them at the state reached (for observations: the environments).
+            :func:`_read_links` reads them at the last step's last evaluation, or (``steps`` 0) at the state (for
+            observations: the environments).
 
     Returns the number of copies that failed. A copy's arithmetic is :func:`articulation_kernel`'s (the same
     ``step``), so each copy advances bit for bit as the articulation alone: a step reads nothing of the work
@@ -217,7 +222,7 @@ def batch_kernel(ints, reals, q, qd, tau, work, external, h, method, steps, copi
                 failed += 1
                 break
         if status == 0 and readout.shape[0] > 0:
-            bad = _read_links(m, w, q_c, qd_c, tau_c, external, h, readout[c])
+            bad = _read_links(m, w, q_c, qd_c, tau_c, external, h, readout[c], steps == 0)
             if bad >= 0:
                 failures[c, 0], failures[c, 1], failures[c, 2] = steps, 1, bad
                 failed += 1

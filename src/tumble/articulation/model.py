@@ -169,6 +169,7 @@ class Work(NamedTuple):
         loop_matrix: (3L, 3L): ``J H⁻¹ Jᵀ`` or its factor.
         loop_work: (4, 3L): rows ``LOOP_RHS`` (γ), ``LOOP_LAMBDA``, ``LOOP_ACTIVE``, ``LOOP_ERROR`` (φ).
         energy: (2,) [J]: kinetic and potential.
+        efc_count: (1,): the number of constraint rows of the last solve (``integrators.accelerations``).
         contact_work: (C, 11): the contacts found (the ``CONTACT_*`` columns), C the most the pairs can make.
         efc_jac: (rows, nv): the Jacobian of each active constraint row, rows = 3S + 4C, turned into ``L⁻ᵀ Jᵀ`` (``H =
             Lᵀ D L``) in place by the solve; efc_factor: (nv, nv): the pivoting's Cholesky factor; efc_z: (nv,): ``Σ fᵢ
@@ -188,6 +189,7 @@ class Work(NamedTuple):
     loop_matrix: np.ndarray
     loop_work: np.ndarray
     energy: np.ndarray
+    efc_count: np.ndarray
     contact_work: np.ndarray
     efc_jac: np.ndarray
     efc_factor: np.ndarray
@@ -210,7 +212,7 @@ def _real_size(n: int, nq: int, nv: int, loops: int, scalars: int, actuators: in
 def work_size(n: int, nq: int, nv: int, loops: int, scalars: int, contacts: int, geoms: int) -> int:
     """The length of the work buffer that :func:`work_views` carves."""
     nc, nr = 3 * loops, 3 * scalars + 4 * contacts
-    return (LINK_WORK_WIDTH * n + 12 * nv + nv * nv + DOF_WORK_ROWS * nv + 2 * nq + 2 * nc * nv + nc * nc + 4 * nc + 2
+    return (LINK_WORK_WIDTH * n + 12 * nv + nv * nv + DOF_WORK_ROWS * nv + 2 * nq + 2 * nc * nv + nc * nc + 4 * nc + 3
             + CONTACT_WIDTH * contacts + nr * nv + nv * nv + 2 * nv + EFC_WORK_ROWS * nr
             + GEOM_POSE_WIDTH * geoms)  # fmt: skip
 
@@ -285,8 +287,8 @@ def work_views(work, n, nq, nv, nl, ns, ncontacts, ngeoms):
     w += nc * nc
     loop_work = _rows(work, w, LOOP_WORK_ROWS, nc)
     w += LOOP_WORK_ROWS * nc
-    energy = work[w : w + 2]
-    w += 2
+    energy, efc_count = work[w : w + 2], work[w + 2 : w + 3]
+    w += 3
     contact_work = _rows(work, w, ncontacts, CONTACT_WIDTH)
     w += ncontacts * CONTACT_WIDTH
     efc_jac = _rows(work, w, nr, nv)
@@ -299,7 +301,7 @@ def work_views(work, n, nq, nv, nl, ns, ncontacts, ngeoms):
     w += EFC_WORK_ROWS * nr
     geom_pose = _rows(work, w, ngeoms, GEOM_POSE_WIDTH)
     return Work(link_work, dof_motion, dof_u, mass_matrix, dof_work, q_start, q_stage, loop_jac, loop_minv_jt,
-                loop_matrix, loop_work, energy, contact_work, efc_jac, efc_factor, efc_z,
+                loop_matrix, loop_work, energy, efc_count, contact_work, efc_jac, efc_factor, efc_z,
                 efc_inverse_pivots, efc_work, geom_pose)  # fmt: skip
 
 

@@ -26,7 +26,7 @@ import numpy as np
 from gymnasium import spaces
 
 from ..articulation import Articulation
-from ..articulation.kernels import READOUT_INERTIA, READOUT_POINT, READOUT_VELOCITY, READOUT_WRENCH
+from ..articulation.kernels import READOUT_INERTIA, READOUT_ORIGIN, READOUT_POINT, READOUT_VELOCITY, READOUT_WRENCH
 from ..models.build import to_articulation
 from ..models.mjcf import read_mjcf
 from .canvas import Canvas
@@ -41,6 +41,7 @@ __all__ = [
     "Walker2dTask",
     "body_terms",
     "centre_of_mass",
+    "root_position",
 ]
 
 ASSETS = Path(str(importlib.resources.files("gymnasium"))) / "envs" / "mujoco" / "assets"
@@ -81,6 +82,11 @@ def body_terms(links: np.ndarray, body_links: np.ndarray):
 def centre_of_mass(links: np.ndarray) -> np.ndarray:
     """(copies, 3) the robot's centre of mass [m] (its base link's tree's) from the readout ``links``."""
     return links[:, 0, READOUT_POINT : READOUT_POINT + 3]
+
+
+def root_position(links: np.ndarray) -> np.ndarray:
+    """(copies, 3) the base link's frame origin [m] (MuJoCo's ``xpos`` of the root body) from the readout."""
+    return links[:, 0, READOUT_ORIGIN : READOUT_ORIGIN + 3]
 
 
 class LocomotionTask(Task):
@@ -391,7 +397,8 @@ class AntTask(_SpatialTask):
         return np.concatenate(parts, axis=1)
 
     def outcome(self, start, actions, q, qd, links):
-        xy_velocity = (q[:, :2] - start[0][:, :2]) / self.dt
+        # the root's xpos, as MuJoCo's mjData holds it after the step (from its last evaluation, as every body term)
+        xy_velocity = (root_position(links)[:, :2] - root_position(start[2])[:, :2]) / self.dt
         forward = self.forward_reward_weight * xy_velocity[:, 0]
         healthy = self.healthy(q, qd)
         survive = healthy * self.healthy_reward
@@ -431,6 +438,10 @@ class HumanoidTask(_SpatialTask):
         size = self.init_q.shape[0] + nv - 2 * self.exclude_current_positions
         self._observation_space(size + sum(widths[name] for name, on in self.include.items() if on))
         self._tendons = [(np.array(t.links), np.array(t.coefficients)) for t in self._template.tendons]
+
+    def control_cost(self, actions):
+        # Humanoid-v5 squares MuJoCo's ctrl (the action stored as float64), the other tasks the action as given
+        return self.ctrl_cost_weight * np.sum(np.square(actions.astype(np.float64)), axis=1)
 
     def healthy(self, q, qd):
         """Gymnasium's ``is_healthy``: the root's height strictly within the range."""
