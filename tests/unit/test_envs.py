@@ -15,6 +15,7 @@ from gymnasium.vector import AutoresetMode  # noqa: E402
 
 import tumble.envs  # noqa: E402
 from tumble.envs import TASKS, TumbleEnv, TumbleVectorEnv, make_env, make_vector_env  # noqa: E402
+from tumble.models.mjcf import MJCFError  # noqa: E402
 from tumble.vehicles import rotor_hubs  # noqa: E402
 
 NAMES = tuple(TASKS)
@@ -334,3 +335,32 @@ def test_the_module_registers_each_env_once():
 
     importlib.reload(tumble.envs)
     assert {f"tumble/{name}" for name in NAMES} <= set(gym.registry)
+
+
+def test_locomotion_arguments_and_actions_are_checked():
+    """Gymnasium's v5 arguments are validated by name, bad actions refused with nothing stepped."""
+    with pytest.raises(ValueError, match="ctrl_cost_weight must be a finite number"):
+        make_env("Hopper", ctrl_cost_weight="x")
+    with pytest.raises(ValueError, match="healthy_z_range must be a .low, high. pair with low <= high"):
+        make_env("Walker2d", healthy_z_range=(2.0, 1.0))
+    with pytest.raises(TypeError, match="terminate_when_unhealthy must be True or False"):
+        make_env("Ant", terminate_when_unhealthy=1)
+    with pytest.raises(ValueError, match="frame_skip must be a positive integer"):
+        make_env("HalfCheetah", frame_skip=0)
+    with pytest.raises(TypeError, match="unexpected keyword argument 'gear'"):
+        make_env("Humanoid", gear=2.0)
+    with pytest.raises(ValueError, match="main_body must be the root body"):
+        make_env("Ant", main_body="aux_1")
+    with pytest.raises(MJCFError, match="no such model file"):
+        make_env("Hopper", xml_file="/nonexistent/hopper.xml")
+    env = make_env("Hopper", frame_skip=2, ctrl_cost_weight=0.5)
+    assert env.task.dt == pytest.approx(0.004) and env.metadata["render_fps"] == 250
+    env.reset(seed=0)
+    before = env.state
+    with pytest.raises(ValueError, match=r"action must have shape \(3,\), got \(2,\)"):
+        env.step(np.zeros(2, dtype=np.float32))
+    with pytest.raises(ValueError, match="action must be finite"):
+        env.step(np.array([0.0, np.nan, 0.0], dtype=np.float32))
+    np.testing.assert_array_equal(env.state[0], before[0])
+    _, reward, _, _, info = env.step(np.full(3, 2.0, dtype=np.float32))  # clipped to ±1 for the motors, not the cost
+    assert info["reward_ctrl"] == pytest.approx(-0.5 * 3 * 4.0)

@@ -105,6 +105,16 @@ class LocomotionTask(Task):
     max_episode_steps = 1000
     reward_reads_start = True  # the forward reward is the displacement over the step
 
+    def _arguments(self, **values) -> None:
+        """Gymnasium's constructor arguments, validated, as attributes of the same names: ``*_range`` a (low, high)
+        pair (or None), ``terminate_when_unhealthy`` a bool, any other a finite number."""
+        for name, value in values.items():
+            if name.endswith("_range"):
+                value = None if value is None else _range(name, value)
+            else:
+                value = _flag(name, value) if name == "terminate_when_unhealthy" else _weight(name, value)
+            setattr(self, name, value)
+
     def _load(self, xml_file, frame_skip, reset_noise_scale, exclude_current_positions) -> None:
         path = ASSETS / self.asset if xml_file is None else Path(xml_file)
         if not path.is_absolute() and xml_file is not None and not path.exists():
@@ -241,14 +251,10 @@ class _PlanarTask(LocomotionTask):
     def __init__(self, xml_file, frame_skip, forward_reward_weight, ctrl_cost_weight, healthy_reward,
                  terminate_when_unhealthy, healthy_z_range, healthy_angle_range, reset_noise_scale,
                  exclude_current_positions_from_observation, healthy_state_range=None) -> None:  # fmt: skip
-        self.forward_reward_weight = _weight("forward_reward_weight", forward_reward_weight)
-        self.ctrl_cost_weight = _weight("ctrl_cost_weight", ctrl_cost_weight)
-        self.healthy_reward = _weight("healthy_reward", healthy_reward)
-        self.terminate_when_unhealthy = _flag("terminate_when_unhealthy", terminate_when_unhealthy)
-        self.healthy_z_range = _range("healthy_z_range", healthy_z_range)
-        self.healthy_angle_range = _range("healthy_angle_range", healthy_angle_range)
-        self.healthy_state_range = None if healthy_state_range is None else _range("healthy_state_range",
-                                                                                   healthy_state_range)  # fmt: skip
+        self._arguments(forward_reward_weight=forward_reward_weight, ctrl_cost_weight=ctrl_cost_weight,
+                        healthy_reward=healthy_reward, terminate_when_unhealthy=terminate_when_unhealthy,
+                        healthy_z_range=healthy_z_range, healthy_angle_range=healthy_angle_range,
+                        healthy_state_range=healthy_state_range)  # fmt: skip
         self._load(xml_file, frame_skip, reset_noise_scale, exclude_current_positions_from_observation)
         self._observation_space(self.init_q.shape[0] + self.init_qd.shape[0] - self.exclude_current_positions)
 
@@ -317,8 +323,7 @@ class HalfCheetahTask(LocomotionTask):
 
     def __init__(self, xml_file=None, frame_skip=5, forward_reward_weight=1.0, ctrl_cost_weight=0.1,
                  reset_noise_scale=0.1, exclude_current_positions_from_observation=True) -> None:  # fmt: skip
-        self.forward_reward_weight = _weight("forward_reward_weight", forward_reward_weight)
-        self.ctrl_cost_weight = _weight("ctrl_cost_weight", ctrl_cost_weight)
+        self._arguments(forward_reward_weight=forward_reward_weight, ctrl_cost_weight=ctrl_cost_weight)
         self._load(xml_file, frame_skip, reset_noise_scale, exclude_current_positions_from_observation)
         self._observation_space(self.init_q.shape[0] + self.init_qd.shape[0] - self.exclude_current_positions)
 
@@ -343,15 +348,6 @@ class _SpatialTask(LocomotionTask):
     skipped_positions = 2
     reads_links = True
 
-    def _common(self, forward_reward_weight, ctrl_cost_weight, contact_cost_weight, healthy_reward,
-                terminate_when_unhealthy, healthy_z_range) -> None:  # fmt: skip
-        self.forward_reward_weight = _weight("forward_reward_weight", forward_reward_weight)
-        self.ctrl_cost_weight = _weight("ctrl_cost_weight", ctrl_cost_weight)
-        self.contact_cost_weight = _weight("contact_cost_weight", contact_cost_weight)
-        self.healthy_reward = _weight("healthy_reward", healthy_reward)
-        self.terminate_when_unhealthy = _flag("terminate_when_unhealthy", terminate_when_unhealthy)
-        self.healthy_z_range = _range("healthy_z_range", healthy_z_range)
-
     def _place_info(self, q) -> dict:
         return {"x_position": q[:, 0].copy(), "y_position": q[:, 1].copy(),
                 "distance_from_origin": np.sqrt(q[:, 0] ** 2 + q[:, 1] ** 2)}  # fmt: skip
@@ -368,9 +364,10 @@ class AntTask(_SpatialTask):
                  healthy_z_range=(0.2, 1.0), contact_force_range=(-1.0, 1.0), reset_noise_scale=0.1,
                  exclude_current_positions_from_observation=True,
                  include_cfrc_ext_in_observation=True) -> None:  # fmt: skip
-        self._common(forward_reward_weight, ctrl_cost_weight, contact_cost_weight, healthy_reward,
-                     terminate_when_unhealthy, healthy_z_range)  # fmt: skip
-        self.contact_force_range = _range("contact_force_range", contact_force_range)
+        self._arguments(forward_reward_weight=forward_reward_weight, ctrl_cost_weight=ctrl_cost_weight,
+                        contact_cost_weight=contact_cost_weight, healthy_reward=healthy_reward,
+                        terminate_when_unhealthy=terminate_when_unhealthy, healthy_z_range=healthy_z_range,
+                        contact_force_range=contact_force_range)  # fmt: skip
         self.include_cfrc_ext = _flag("include_cfrc_ext_in_observation", include_cfrc_ext_in_observation)
         self._load(xml_file, frame_skip, reset_noise_scale, exclude_current_positions_from_observation)
         root = self.description.bodies[0].name
@@ -425,9 +422,10 @@ class HumanoidTask(_SpatialTask):
                  exclude_current_positions_from_observation=True, include_cinert_in_observation=True,
                  include_cvel_in_observation=True, include_qfrc_actuator_in_observation=True,
                  include_cfrc_ext_in_observation=True) -> None:  # fmt: skip
-        self._common(forward_reward_weight, ctrl_cost_weight, contact_cost_weight, healthy_reward,
-                     terminate_when_unhealthy, healthy_z_range)  # fmt: skip
-        self.contact_cost_range = _range("contact_cost_range", contact_cost_range)
+        self._arguments(forward_reward_weight=forward_reward_weight, ctrl_cost_weight=ctrl_cost_weight,
+                        contact_cost_weight=contact_cost_weight, healthy_reward=healthy_reward,
+                        terminate_when_unhealthy=terminate_when_unhealthy, healthy_z_range=healthy_z_range,
+                        contact_cost_range=contact_cost_range)  # fmt: skip
         self.include = {name: _flag(f"include_{name}_in_observation", value) for name, value in
                         (("cinert", include_cinert_in_observation), ("cvel", include_cvel_in_observation),
                          ("qfrc_actuator", include_qfrc_actuator_in_observation),
