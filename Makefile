@@ -5,7 +5,7 @@ PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
 BROWSER_STAMP := $(VENV)/.browser
 
-.PHONY: install demo test test-slow bench lint clean
+.PHONY: install demo test test-slow bench bench-mjbatch lint clean
 
 # The venv, then the kernels compiled two processes at a time (tumble warmup), so that the first run starts at once.
 $(STAMP): pyproject.toml
@@ -52,7 +52,7 @@ BOUNDSCHECK_TESTS := tests/unit/test_gjk.py tests/unit/test_collide_convex.py te
 	tests/analytic/test_contact.py tests/analytic/test_contact_rates.py \
 	tests/analytic/test_shipped_scenes.py::test_the_mixed_pile_runs_12_s_at_240_hz_past_its_old_crash \
 	tests/analytic/test_native_flight.py tests/analytic/test_sensors.py \
-	tests/peers/test_mjcf_joint_physics.py tests/peers/test_mjcf_contacts.py
+	tests/peers/test_mjcf_joint_physics.py tests/peers/test_mjcf_contacts.py tests/peers/test_locomotion_envs.py
 
 # The tests marked slow (every shipped scene at every rate, the long scenes), then the bounds-checked pass. Numba's
 # cache does not tell a bounds-checked build from a plain one, so that pass compiles into a cache of its own.
@@ -65,10 +65,16 @@ bench: $(STAMP)
 	$(PY) -m pip install --quiet -e ".[bench]"
 	$(PY) -m benchmarks.run
 
+# tumble's vector envs beside mjbatch (MuJoCo batched on C++ threads), which pins a MuJoCo of its own: its own venv.
+bench-mjbatch:
+	test -x .venv-mjbatch/bin/python || $(PYTHON) -m venv .venv-mjbatch
+	.venv-mjbatch/bin/python -m pip install --quiet mjbatch gymnasium -e .
+	.venv-mjbatch/bin/python -m benchmarks.mjbatch_envs
+
 lint: $(STAMP)
 	$(VENV)/bin/ruff check src tests benchmarks examples
 	$(VENV)/bin/ruff format --check src tests benchmarks examples
 
 clean:
-	rm -rf $(VENV) out .pytest_cache .ruff_cache
+	rm -rf $(VENV) .venv-mjbatch out .pytest_cache .ruff_cache
 	find . -name __pycache__ -prune -exec rm -rf {} +
