@@ -357,12 +357,14 @@ def test_envs_rows_for_every_env_with_ratios_to_mujoco():
     _assert_finite_numbers(rows)
     ours = [r for r in rows if r["engine"] == "tumble"]
     assert {r["env"] for r in ours} == {"tumble/CartPole", "tumble/DoublePendulum", "tumble/Pendulum",
-                                         "tumble/QuadrotorHover"}  # fmt: skip
+                                         "tumble/QuadrotorHover", "tumble/Hopper", "tumble/Walker2d",
+                                         "tumble/HalfCheetah", "tumble/Ant", "tumble/Humanoid"}  # fmt: skip
     assert all(r["env_steps_per_s"] > 0 for r in rows)
     assert {r["copies"] for r in ours if r["kind"] == "vector"} == {1, 4}
     if any(r["engine"] == "MuJoCo" for r in rows):
         assert all("x_mujoco_single" in r for r in ours if r["env"] == "tumble/CartPole" and r["kind"] == "single")
         assert all("x_mujoco_vec4" in r for r in ours if r["env"] == "tumble/DoublePendulum" and r["kind"] == "vector")
+        assert all("x_mujoco_vec4" in r for r in ours if r["env"] == "tumble/Ant" and r["kind"] == "vector")
 
 
 @pytest.mark.slow  # 20 s: four process pools and two Dask clusters start
