@@ -69,7 +69,7 @@ bench: $(STAMP)
 bench-mjbatch:
 	test -x .venv-mjbatch/bin/python || $(PYTHON) -m venv .venv-mjbatch
 	.venv-mjbatch/bin/python -m pip install --quiet mjbatch gymnasium -e .
-	.venv-mjbatch/bin/python -m benchmarks.mjbatch_envs
+	.venv-mjbatch/bin/python -m benchmarks.beside_mjbatch
 
 lint: $(STAMP)
 	$(VENV)/bin/ruff check src tests benchmarks examples

@@ -6,8 +6,11 @@ Run from the repository root:
     python -m benchmarks.run --only batch
 
 ``tumbling``  4096 copies of one free body (I = diag(1, 2, 3) kg m², ω₀ = (0.01, 5, 0.01) rad/s, no gravity),
-              1000 steps of 1 ms: tumble's default integrator (RK4 for this anisotropic body) in one
-              ``batch.step(dt, steps)`` call, MuJoCo's RK4 and Euler in one rollout call.
+              1000 steps of 1 ms in one ``batch.step(dt, steps)`` call, like for like (issue 49): tumble's RK4
+              beside MuJoCo's RK4, tumble's symplectic (semi-implicit) Euler beside MuJoCo's Euler (semi-implicit
+              too), each in one rollout call; and tumble's default (``auto``: RK4 for this body).
+``isotropic`` the same with I = diag(2, 2, 2) kg m²: tumble's default flies an isotropic body in closed form (the
+              row the 9-33x figures of issue 28 came from), beside MuJoCo's RK4 and Euler.
 ``pile``      1024 copies of a pile of 10 cubes of 0.2 m (``scenes.box_pile(10)``) dropped on a plane, 1 s: tumble
               at 60 Hz (its default, 8 substeps), MuJoCo at 60 Hz (the same step) and 240 Hz (the contact
               benchmarks' rate, where its default soft contacts hold a pile), Newton solver.
@@ -35,7 +38,10 @@ from .timing import best_time, show_row, sizes_from_args
 __all__ = ["bench_batch", "BatchSizes", "FULL", "QUICK"]
 
 INERTIA = (1.0, 2.0, 3.0)
+ISOTROPIC = (2.0, 2.0, 2.0)
 OMEGA = (0.01, 5.0, 0.01)
+# tumble's integrator beside the MuJoCo integrator it is like (the same order and kind of step)
+LIKE = {"rk4": "RK4", "symplectic": "Euler"}
 
 
 @dataclass(frozen=True)
@@ -60,14 +66,14 @@ def _row(scene, engine, config, hz, threads, copies, bodies, steps, seconds) -> 
     }  # fmt: skip
 
 
-def _tumbling_world() -> tumble.World:
-    world = tumble.World(gravity=(0.0, 0.0, 0.0))
-    mass = tumble.MassProperties(1.0, (0.0, 0.0, 0.0), np.diag(INERTIA))
+def _tumbling_world(inertia=INERTIA, integrator="auto") -> tumble.World:
+    world = tumble.World(gravity=(0.0, 0.0, 0.0), integrator=integrator)
+    mass = tumble.MassProperties(1.0, (0.0, 0.0, 0.0), np.diag(inertia))
     world.add_body(mass_properties=mass, angular_velocity=OMEGA)
     return world
 
 
-def _tumble_rows(scene, world, copies, hz, steps, bodies, repeat) -> list[dict]:
+def _tumble_rows(scene, world, copies, hz, steps, bodies, repeat, config=None) -> list[dict]:
     rows = []
     for threads in _thread_counts():
         batch = tumble.Batch(world, copies)
@@ -78,8 +84,8 @@ def _tumble_rows(scene, world, copies, hz, steps, bodies, repeat) -> list[dict]:
 
         with integrate.using_threads(threads):
             seconds = best_time(run, repeat)
-        rows.append(_row(scene, "tumble", f"Batch, {len(batch._blocks)} block(s)", hz, threads, copies, bodies,
-                         steps, seconds))  # fmt: skip
+        label = f"Batch, {len(batch._blocks)} block(s)" if config is None else config
+        rows.append(_row(scene, "tumble", label, hz, threads, copies, bodies, steps, seconds))
     return rows
 
 
@@ -114,18 +120,23 @@ def _thread_counts() -> list[int]:
 
 
 def bench_tumbling(sizes: BatchSizes) -> list[dict]:
-    hz = 1000
-    rows = _tumble_rows("tumbling", _tumbling_world(), sizes.tumbling_copies, hz, sizes.tumbling_steps, 1,
-                        sizes.repeat)  # fmt: skip
+    """The anisotropic body with each of tumble's integrators like MuJoCo's and its default; the isotropic one with
+    tumble's default (closed-form flight); MuJoCo's RK4 and Euler beside each."""
+    hz, rows = 1000, []
+    runs = [("tumbling", INERTIA, integrator) for integrator in (*LIKE, "auto")] + [("isotropic", ISOTROPIC, "auto")]
+    for scene, inertia, integrator in runs:
+        rows += _tumble_rows(scene, _tumbling_world(inertia, integrator), sizes.tumbling_copies, hz,
+                             sizes.tumbling_steps, 1, sizes.repeat, integrator)  # fmt: skip
     if peers.have_mujoco():
 
         def spin(model, data):
             peers.set_free_body_angvel(model, data, np.array([OMEGA]))
 
-        for integrator in ("RK4", "Euler"):
-            xml = peers.tumbling_body_mjcf(integrator, 1.0 / hz, 1.0, INERTIA)
-            rows += _mujoco_rows("tumbling", xml, sizes.tumbling_copies, hz, sizes.tumbling_steps, 1, sizes.repeat,
-                                 integrator, spin)  # fmt: skip
+        for scene, inertia in (("tumbling", INERTIA), ("isotropic", ISOTROPIC)):
+            for integrator in ("RK4", "Euler"):
+                xml = peers.tumbling_body_mjcf(integrator, 1.0 / hz, 1.0, inertia)
+                rows += _mujoco_rows(scene, xml, sizes.tumbling_copies, hz, sizes.tumbling_steps, 1, sizes.repeat,
+                                     integrator, spin)  # fmt: skip
     return rows
 
 
@@ -148,7 +159,8 @@ def bench_pile(sizes: BatchSizes) -> list[dict]:
 
 
 def with_ratios(rows: list[dict]) -> list[dict]:
-    """Tumble's rows with ``x_<peer>`` columns: its rate over MuJoCo's with the same scene and threads."""
+    """Tumble's rows with ``x_<peer>`` columns: its rate over MuJoCo's with the same scene and threads, and
+    ``x_like_for_like``: over the MuJoCo integrator its own is like (``LIKE``)."""
     for row in rows:
         if row["engine"] != "tumble":
             continue
@@ -156,6 +168,8 @@ def with_ratios(rows: list[dict]) -> list[dict]:
             if peer["engine"] == "MuJoCo" and peer["scene"] == row["scene"] and peer["threads"] == row["threads"]:
                 if peer["hz"] == row["hz"]:
                     row[f"x_mujoco_{peer['config']}_steps"] = row["body_steps_per_s"] / peer["body_steps_per_s"]
+                    if LIKE.get(row["config"]) == peer["config"]:
+                        row["x_like_for_like"] = row["body_steps_per_s"] / peer["body_steps_per_s"]
                 if row["scene"] == "pile" and peer["hz"] == 240:
                     row["x_mujoco_240hz_sim_time"] = row["sim_s_per_s"] / peer["sim_s_per_s"]
     return rows

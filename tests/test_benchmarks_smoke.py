@@ -343,10 +343,13 @@ def test_batch_rows_for_both_scenes_with_ratios_to_mujoco():
     rows = batch.bench_batch(batch.QUICK)
     _assert_finite_numbers(rows)
     tumble_rows = [r for r in rows if r["engine"] == "tumble"]
-    assert {r["scene"] for r in tumble_rows} == {"tumbling", "pile"}
-    assert all(r["body_steps_per_s"] > 0 and r["copies"] == (8 if r["scene"] == "tumbling" else 4) for r in tumble_rows)
+    assert {r["scene"] for r in tumble_rows} == {"tumbling", "isotropic", "pile"}
+    assert {r["config"] for r in tumble_rows if r["scene"] == "tumbling"} == {"rk4", "symplectic", "auto"}
+    assert all(r["body_steps_per_s"] > 0 and r["copies"] == (4 if r["scene"] == "pile" else 8) for r in tumble_rows)
     if any(r["engine"] == "MuJoCo" for r in rows):
-        assert all("x_mujoco_Euler_steps" in r for r in tumble_rows if r["scene"] == "tumbling")
+        assert all("x_mujoco_Euler_steps" in r for r in tumble_rows if r["scene"] != "pile")
+        like = {r["config"]: "x_like_for_like" in r for r in tumble_rows if r["scene"] == "tumbling"}
+        assert like == {"rk4": True, "symplectic": True, "auto": False}
         assert all("x_mujoco_240hz_sim_time" in r for r in tumble_rows if r["scene"] == "pile")
 
 

@@ -1,11 +1,11 @@
-"""tumble's native vector envs beside mjbatch (MuJoCo batched on C++ threads), 1024 copies of the ant and the
-half-cheetah (issue 48).
+"""tumble beside mjbatch (MuJoCo batched on C++ threads): native vector envs, 1024 copies of the ant and the
+half-cheetah (issue 48); 4096 tumbling free bodies in a ``tumble.Batch`` (issue 49).
 
 mjbatch 0.1.4 pins ``mujoco==3.14.0``, which the test and bench extras' MuJoCo 4 rules out, so this runs in a venv of
 its own (mjbatch, Gymnasium and tumble):
 
     make bench-mjbatch                       # builds .venv-mjbatch, then runs this module
-    .venv-mjbatch/bin/python -m benchmarks.mjbatch_envs [--quick] [--repeat N]
+    .venv-mjbatch/bin/python -m benchmarks.beside_mjbatch [--quick] [--repeat N]
 
 Rows, in env-steps (copies × control steps) per second, on 1 and 2 threads, the same MJCF file, timestep, integrator
 and ``frame_skip``:
@@ -18,6 +18,9 @@ and ``frame_skip``:
 - ``tumble physics`` and ``mjbatch physics``: the controls set and the steps taken, nothing else (no resets).
 
 Random actions drawn beforehand, the same for both; best of ``--repeat`` runs after an untimed one.
+
+Tumbling: ``benchmarks/batch.py``'s anisotropic spinning body, 4096 copies for 1000 steps of 1 ms, tumble's RK4 beside
+mjbatch's RK4 and tumble's symplectic Euler beside mjbatch's Euler, in body-steps per second.
 """
 
 from __future__ import annotations
@@ -38,11 +41,13 @@ TASKS = {"Ant": ("ant.xml", 5, 2), "HalfCheetah": ("half_cheetah.xml", 5, 1)}  #
 class MjbatchSizes:
     copies: int = 1024
     steps: int = 20
+    tumbling_copies: int = 4096
+    tumbling_steps: int = 1000
     repeat: int = 3
 
 
 FULL = MjbatchSizes()
-QUICK = MjbatchSizes(copies=8, steps=2, repeat=1)
+QUICK = MjbatchSizes(copies=8, steps=2, tumbling_copies=8, tumbling_steps=20, repeat=1)
 
 
 def _tumble_env(task: str, copies: int, steps: int, actions, repeat: int) -> float:
@@ -107,6 +112,49 @@ def _mjbatch(task: str, copies: int, threads: int, steps: int, actions, repeat: 
     return copies * steps / best_time(run, repeat)
 
 
+def bench_tumbling(sizes: MjbatchSizes = FULL, report=None) -> list[dict]:
+    """4096 anisotropic spinning bodies: tumble's RK4 and symplectic Euler beside mjbatch's RK4 and Euler."""
+    import mujoco
+    from mjbatch import Batch
+
+    import tumble
+    from tumble.dynamics import integrate
+
+    from . import peers
+    from .batch import INERTIA, LIKE, OMEGA, _tumbling_world
+
+    copies, steps, rows = sizes.tumbling_copies, sizes.tumbling_steps, []
+    for threads in (1, 2):
+        for ours, theirs in LIKE.items():
+            batch = tumble.Batch(_tumbling_world(INERTIA, ours), copies)
+
+            def run_tumble(batch=batch):
+                batch.reset()
+                batch.step(1e-3, steps=steps)
+
+            with integrate.using_threads(threads):
+                rate = copies * steps / best_time(run_tumble, sizes.repeat)
+            model = mujoco.MjModel.from_xml_string(peers.tumbling_body_mjcf(theirs, 1e-3, 1.0, INERTIA))
+            sims = Batch(model, copies, num_threads=threads)
+            qvel = sims.bind("qvel")
+
+            def run_mjbatch(sims=sims, qvel=qvel):
+                sims.reset(np.arange(copies))
+                qvel[:, 3:] = OMEGA  # a free joint's angular velocity is in its body frame, here the principal axes
+                sims.step(nstep=steps)
+
+            peer = copies * steps / best_time(run_mjbatch, sizes.repeat)
+            for engine, config, value in (("tumble", ours, rate), ("mjbatch", theirs, peer)):
+                row = {"task": "tumbling", "kind": f"{engine} {config}", "copies": copies, "threads": threads,
+                       "body_steps_per_s": value}  # fmt: skip
+                if engine == "tumble":
+                    row["x_mjbatch"] = rate / peer
+                rows.append(row)
+                if report is not None:
+                    report(row)
+    return rows
+
+
 def bench_mjbatch(sizes: MjbatchSizes = FULL, report=None) -> list[dict]:
     import gymnasium as gym
 
@@ -139,7 +187,9 @@ def bench_mjbatch(sizes: MjbatchSizes = FULL, report=None) -> list[dict]:
 
 
 def main(argv: list[str] | None = None) -> int:
-    bench_mjbatch(sizes_from_args(argv, "python -m benchmarks.mjbatch_envs", __doc__, FULL, QUICK), report=show_row)
+    sizes = sizes_from_args(argv, "python -m benchmarks.beside_mjbatch", __doc__, FULL, QUICK)
+    bench_mjbatch(sizes, report=show_row)
+    bench_tumbling(sizes, report=show_row)
     return 0
 
 
