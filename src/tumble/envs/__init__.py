@@ -1,5 +1,7 @@
-"""Gymnasium environments on tumble's articulations: ``tumble/CartPole``, ``tumble/Pendulum``,
-``tumble/DoublePendulum`` and ``tumble/QuadrotorHover`` (extra ``rl``: ``pip install 'tumble[rl]'``).
+"""Gymnasium environments on tumble's articulations (extra ``rl``: ``pip install 'tumble[rl]'``): ``tumble/CartPole``,
+``tumble/Pendulum``, ``tumble/DoublePendulum``, ``tumble/QuadrotorHover``, and Gymnasium's MuJoCo locomotion tasks
+(v5) from the same MJCF files: ``tumble/Hopper``, ``tumble/Walker2d``, ``tumble/HalfCheetah``, ``tumble/Ant`` and
+``tumble/Humanoid``.
 
 >>> import gymnasium as gym
 >>> import tumble.envs  # registers the environments
@@ -11,7 +13,9 @@
 (64, 4)
 
 Each environment's physics and reward are documented beside its Gymnasium (or RotorPy) counterpart in its module
-and in ``docs/envs.md``. The vector versions step every copy in one compiled call (:class:`TumbleVectorEnv`).
+and in ``docs/envs.md``. The vector versions step every copy in one compiled call (:class:`TumbleVectorEnv`); copy
+``i`` of ``reset(seed=s)`` is the single env seeded ``s + i``, bit for bit. ``gym.make("tumble/Hopper",
+ctrl_cost_weight=...)`` passes Gymnasium's v5 arguments to the task.
 """
 
 from __future__ import annotations
