@@ -29,6 +29,7 @@ from ..articulation import Articulation
 from ..articulation.kernels import READOUT_INERTIA, READOUT_ORIGIN, READOUT_POINT, READOUT_VELOCITY, READOUT_WRENCH
 from ..models.build import to_articulation
 from ..models.mjcf import read_mjcf
+from ..rotation import quat_rotate
 from .canvas import Canvas
 from .core import Task
 
@@ -171,13 +172,13 @@ class LocomotionTask(Task):
 
     def initial_state(self, rng):
         noise = self.reset_noise_scale
+        # a free joint's quaternion keeps its noise unnormalised, as MuJoCo's qpos does until the first step (the
+        # kinematics read it normalised; the step's update normalises it)
         q = self.init_q + rng.uniform(-noise, noise, size=self.init_q.shape[0])
         if self.uniform_velocity_noise:
             qd = self.init_qd + rng.uniform(-noise, noise, size=self.init_qd.shape[0])
         else:
             qd = self.init_qd + noise * rng.standard_normal(self.init_qd.shape[0])
-        # a free joint's quaternion keeps its noise unnormalised, as MuJoCo's qpos does until the first step (the
-        # kinematics read it normalised; the step's update normalises it)
         return q, qd
 
     def prepare(self, actions, q, qd, tau):
@@ -189,12 +190,10 @@ class LocomotionTask(Task):
                              f"got {actions.shape[1:] if count == 1 else actions.shape}")  # fmt: skip
         if not np.all(np.isfinite(actions)):
             raise ValueError(f"action must be finite, got {actions[~np.all(np.isfinite(actions), axis=1)][0]!r}")
-        if not np.issubdtype(actions.dtype, np.floating):
-            actions = actions.astype(np.float64)
-        # only the motors' rows of tau are ever set (a start zeroes them all)
         ctrl = actions.astype(np.float64)
+        # only the motors' rows of tau are ever set (a start zeroes them all)
         tau[:, self.motor_dofs] = self.gears * np.minimum(np.maximum(ctrl, self.ctrl_low), self.ctrl_high)
-        return actions
+        return actions if np.issubdtype(actions.dtype, np.floating) else ctrl
 
     def _positions(self, q):
         return q[:, self.skipped_positions :] if self.exclude_current_positions else q
@@ -209,8 +208,8 @@ class LocomotionTask(Task):
         for geom in self._template.geoms:
             if geom.link is None or geom.kind == "plane":
                 continue
-            centre = positions[geom.link] + _rotate(quats[geom.link], geom.position)
-            axis = _rotate(quats[geom.link], _rotate(geom.orientation, (0.0, 0.0, geom.size[1])))
+            centre = positions[geom.link] + quat_rotate(quats[geom.link], geom.position)
+            axis = quat_rotate(quats[geom.link], quat_rotate(geom.orientation, (0.0, 0.0, geom.size[1])))
             a, b = centre - axis, centre + axis
             if geom.kind == "sphere":
                 a = b = centre
@@ -233,13 +232,6 @@ class LocomotionTask(Task):
 
     def control_cost(self, actions):
         return self.ctrl_cost_weight * np.sum(np.square(actions), axis=1)
-
-
-def _rotate(quat, v):
-    w, x, y, z = quat
-    u = np.array([x, y, z])
-    v = np.asarray(v, dtype=np.float64)
-    return v + 2.0 * np.cross(u, np.cross(u, v) + w * v)
 
 
 class _PlanarTask(LocomotionTask):
