@@ -66,7 +66,7 @@ def _row(scene, engine, config, hz, threads, copies, bodies, steps, seconds) -> 
     }  # fmt: skip
 
 
-def _tumbling_world(inertia=INERTIA, integrator="auto") -> tumble.World:
+def tumbling_world(inertia=INERTIA, integrator="auto") -> tumble.World:
     world = tumble.World(gravity=(0.0, 0.0, 0.0), integrator=integrator)
     mass = tumble.MassProperties(1.0, (0.0, 0.0, 0.0), np.diag(inertia))
     world.add_body(mass_properties=mass, angular_velocity=OMEGA)
@@ -125,7 +125,7 @@ def bench_tumbling(sizes: BatchSizes) -> list[dict]:
     hz, rows = 1000, []
     runs = [("tumbling", INERTIA, integrator) for integrator in (*LIKE, "auto")] + [("isotropic", ISOTROPIC, "auto")]
     for scene, inertia, integrator in runs:
-        rows += _tumble_rows(scene, _tumbling_world(inertia, integrator), sizes.tumbling_copies, hz,
+        rows += _tumble_rows(scene, tumbling_world(inertia, integrator), sizes.tumbling_copies, hz,
                              sizes.tumbling_steps, 1, sizes.repeat, integrator)  # fmt: skip
     if peers.have_mujoco():
 

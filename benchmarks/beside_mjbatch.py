@@ -121,12 +121,12 @@ def bench_tumbling(sizes: MjbatchSizes = FULL, report=None) -> list[dict]:
     from tumble.dynamics import integrate
 
     from . import peers
-    from .batch import INERTIA, LIKE, OMEGA, _tumbling_world
+    from .batch import INERTIA, LIKE, OMEGA, tumbling_world
 
     copies, steps, rows = sizes.tumbling_copies, sizes.tumbling_steps, []
     for threads in (1, 2):
         for ours, theirs in LIKE.items():
-            batch = tumble.Batch(_tumbling_world(INERTIA, ours), copies)
+            batch = tumble.Batch(tumbling_world(INERTIA, ours), copies)
 
             def run_tumble(batch=batch):
                 batch.reset()

@@ -63,12 +63,16 @@ def test_spaces_starts_and_info_are_gymnasiums(name, arguments):
         assert ours.step(action)[4].keys() == theirs.step(action)[4].keys()
 
 
-@pytest.mark.parametrize("name", NAMES)
-def test_each_step_pays_as_gymnasiums(name):
+@pytest.mark.parametrize(
+    ("name", "arguments"),
+    [(name, {}) for name in NAMES]
+    + [("Ant", {"frame_skip": 2}), ("HalfCheetah", {"frame_skip": 1}), ("Hopper", {"frame_skip": 8})],
+)
+def test_each_step_pays_as_gymnasiums(name, arguments):
     """Both engines from the same seed, given the same actions: the same terminations, and every observation entry,
     reward term and info value as close as BOUND (the body terms of the ant and the humanoid included: tumble reads them
-    where MuJoCo's mjData holds them after mj_step, at the step's last evaluation)."""
-    ours, theirs = _pair(name)
+    where MuJoCo's mjData holds them after mj_step, at the step's last evaluation). Also at other control steps."""
+    ours, theirs = _pair(name, arguments)
     humanoid = name == "Humanoid"
     bound = HUMANOID_BOUND if humanoid else BOUND[name]
     cfrc = slice(270, 348) if humanoid else slice(0, 0)

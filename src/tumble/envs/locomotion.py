@@ -93,14 +93,13 @@ def root_position(links: np.ndarray) -> np.ndarray:
 class LocomotionTask(Task):
     """What the five tasks share: the asset, the motors, the reset noise, the forward reward and the picture.
 
-    Subclasses set ``asset`` (the file name), ``frame_skip`` (Gymnasium's default), ``skipped_positions`` (the
-    leading ``qpos`` entries an observation leaves out: 1 for the planar robots, 2 for those on a free joint) and
-    ``uniform_velocity_noise`` (whether the start's velocity noise is uniform, else normal), and call
-    :meth:`_load` from ``__init__``.
+    Subclasses set ``asset`` (the file name; ``frame_skip``'s default is their constructor's),
+    ``skipped_positions`` (the leading ``qpos`` entries an observation leaves out: 1 for the planar robots, 2 for
+    those on a free joint) and ``uniform_velocity_noise`` (whether the start's velocity noise is uniform, else
+    normal), and call :meth:`_load` from ``__init__``.
     """
 
     asset: str
-    frame_skip: int
     skipped_positions: int
     uniform_velocity_noise: bool
     max_episode_steps = 1000
@@ -280,7 +279,7 @@ class _PlanarTask(LocomotionTask):
 class HopperTask(_PlanarTask):
     """``tumble/Hopper``: Gymnasium's ``Hopper-v5`` (``hopper.xml``, four RK4 steps of 2 ms a control step)."""
 
-    asset, frame_skip = "hopper.xml", 4
+    asset = "hopper.xml"
 
     def __init__(self, xml_file=None, frame_skip=4, forward_reward_weight=1.0, ctrl_cost_weight=1e-3,
                  healthy_reward=1.0, terminate_when_unhealthy=True, healthy_state_range=(-100.0, 100.0),
@@ -294,7 +293,7 @@ class HopperTask(_PlanarTask):
 class Walker2dTask(_PlanarTask):
     """``tumble/Walker2d``: Gymnasium's ``Walker2d-v5`` (``walker2d_v5.xml``, four RK4 steps of 2 ms)."""
 
-    asset, frame_skip = "walker2d_v5.xml", 4
+    asset = "walker2d_v5.xml"
 
     def __init__(self, xml_file=None, frame_skip=4, forward_reward_weight=1.0, ctrl_cost_weight=1e-3,
                  healthy_reward=1.0, terminate_when_unhealthy=True, healthy_z_range=(0.8, 2.0),
@@ -309,7 +308,7 @@ class HalfCheetahTask(LocomotionTask):
     """``tumble/HalfCheetah``: Gymnasium's ``HalfCheetah-v5`` (``half_cheetah.xml``, five Euler steps of 10 ms);
     it never terminates."""
 
-    asset, frame_skip = "half_cheetah.xml", 5
+    asset = "half_cheetah.xml"
     skipped_positions = 1
     uniform_velocity_noise = False
 
@@ -348,7 +347,7 @@ class _SpatialTask(LocomotionTask):
 class AntTask(_SpatialTask):
     """``tumble/Ant``: Gymnasium's ``Ant-v5`` (``ant.xml``, five RK4 steps of 10 ms a control step)."""
 
-    asset, frame_skip = "ant.xml", 5
+    asset = "ant.xml"
     uniform_velocity_noise = False
 
     def __init__(self, xml_file=None, frame_skip=5, forward_reward_weight=1.0, ctrl_cost_weight=0.5,
@@ -405,7 +404,7 @@ class AntTask(_SpatialTask):
 class HumanoidTask(_SpatialTask):
     """``tumble/Humanoid``: Gymnasium's ``Humanoid-v5`` (``humanoid.xml``, five RK4 steps of 3 ms a control step)."""
 
-    asset, frame_skip = "humanoid.xml", 5
+    asset = "humanoid.xml"
     uniform_velocity_noise = True
 
     def __init__(self, xml_file=None, frame_skip=5, forward_reward_weight=1.25, ctrl_cost_weight=0.1,
