@@ -154,7 +154,7 @@ def kernel(function=None, *, parallel: bool = False):
     return wrap(function) if function is not None else wrap
 
 
-def inline(function=None, *, into_callers: bool = False, counted: bool = True):
+def inline(function=None, *, into_callers: bool = False, counted: bool = True, ieee_division: bool = False):
     """Compile a function that only compiled code calls: the helpers of ``math3d``, the solvers' passes, the
     collision routines. Without Python or C wrappers (:class:`_Helper`).
 
@@ -166,10 +166,16 @@ def inline(function=None, *, into_callers: bool = False, counted: bool = True):
     ``counted=False`` compiles it without reference counts at all (:class:`_UncountedHelper`): for a function over
     many arrays that allocates none and returns none, called often. Each array it holds costs two atomic operations
     a call otherwise, about 10 ns (a call over twelve arrays: 128 ns counted, 9 ns not).
+
+    ``ieee_division=True`` compiles it with NumPy's error model: a float division by zero gives an infinity or a NaN,
+    as IEEE 754 says, instead of raising. Python's model tests every divisor, a branch that keeps LLVM from
+    vectorising a loop over many copies (``articulation/chain.py``); the caller must then check the results.
     """
 
     def wrap(f):
         options = {"inline": "always"} if into_callers else {}
+        if ieee_division:
+            options["error_model"] = "numpy"
         if not counted:
             return _compiled(f, _UncountedHelper, no_cpython_wrapper=True, no_cfunc_wrapper=True, _nrt=False, **options)
         return _compiled(f, _Helper, no_cpython_wrapper=True, no_cfunc_wrapper=True, **options)

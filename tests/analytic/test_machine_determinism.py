@@ -35,7 +35,7 @@ VARIANTS = {
 # The model of each case (a case without a rate) and 2 s of it at 60 and 240 Hz.
 CASES = ("mixed_pile", "hull_pile", "ant", "ant_articulation", "flagship", "ragdoll_stairs", "robot_arm", "dzhanibekov",
          "four_bar", "quadrotor_figure_eight_wind")  # fmt: skip
-RUNS = (*CASES, *(f"{case}@{rate}" for case in CASES for rate in (60, 240)), "ant_env")
+RUNS = (*CASES, *(f"{case}@{rate}" for case in CASES for rate in (60, 240)), "ant_env", "double_pendulum_env")
 # Numba compiles every kernel again for a generic CPU (minutes for them all): there, the cases whose kernels are
 # fewest, and each step path still once (hull contacts, joints and capsules, free flight, rotors and wind).
 GENERIC_RUNS = (
@@ -45,6 +45,7 @@ GENERIC_RUNS = (
     "ant@60",
     "ant_articulation@60",
     "ant_env",
+    "double_pendulum_env",
     "dzhanibekov@60",
     "quadrotor_figure_eight_wind@60",
 )

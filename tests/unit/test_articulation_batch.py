@@ -10,6 +10,7 @@ import pytest
 from compiled import compiled_only
 from tumble import SimulationError
 from tumble.articulation import Articulation, ArticulationBatch, Ball, Free, Prismatic, Revolute
+from tumble.articulation.chain import BLOCK
 from tumble.dynamics.integrate import using_threads
 from tumble.mass import MassProperties
 from tumble.shapes import Box
@@ -52,6 +53,20 @@ def free_body() -> Articulation:
     return art
 
 
+def slide_hinge_chain() -> Articulation:
+    """A serial chain of six slides and hinges (the short-chain path, ``articulation/chain.py``) with all it handles:
+    tilted gravity, turned joint frames and axes, offset masses, damping, springs and armature."""
+    art = Articulation(gravity=(0.3, -0.2, -9.81))
+    link = art.add_link(Prismatic((0.6, 0.8, 0.0)), mass=2.0, damping=0.3, armature=0.01, position=(0.1, 0.2, 0.3),
+                        orientation=(0.9, 0.1, 0.3, 0.2))  # fmt: skip
+    for i in range(5):
+        joint = Revolute((0.2, 1.0, 0.1)) if i % 2 == 0 else Prismatic((0.0, 0.3, 1.0))
+        link = art.add_link(joint, parent=link, position=(0.1, 0.05 * i, 0.4), orientation=(1.0, 0.2 * i, 0.0, 0.1),
+                            shape=Box((0.1, 0.05, 0.3)), mass=0.5 + 0.1 * i, shape_position=(0.02, 0.01, 0.2),
+                            damping=0.05 * i, stiffness=2.0 * (i % 3), springref=0.1, armature=0.001 * i)  # fmt: skip
+    return art
+
+
 def _spread(art: Articulation, batch: ArticulationBatch, rng) -> None:
     """Different starts and joint forces per copy (quaternions stay unit: the hinges' rows only)."""
     quat_rows = {row for start, _ in art._quat_starts for row in range(start, start + 4)}
@@ -62,7 +77,7 @@ def _spread(art: Articulation, batch: ArticulationBatch, rng) -> None:
     batch.tau[...] = rng.uniform(-1.0, 1.0, batch.tau.shape)
 
 
-@pytest.mark.parametrize("build", [cart_pole, ball_chain, four_bar, free_body])
+@pytest.mark.parametrize("build", [cart_pole, slide_hinge_chain, ball_chain, four_bar, free_body])
 @pytest.mark.parametrize("integrator", ["rk4", "symplectic", "euler"])
 def test_every_copy_moves_bit_for_bit_as_the_articulation_alone(build, integrator):
     art = build()
@@ -80,6 +95,62 @@ def test_every_copy_moves_bit_for_bit_as_the_articulation_alone(build, integrato
         np.testing.assert_array_equal(batch.q[c], alone.q)
         np.testing.assert_array_equal(batch.qd[c], alone.qd)
     assert np.ptp(batch.q[:, -1]) > 0.0  # the copies differ
+
+
+@compiled_only("150 copies over 40 steps: minutes as plain Python")
+@pytest.mark.parametrize("threads", [1, 2])
+@pytest.mark.parametrize("integrator", ["rk4", "symplectic", "euler"])
+def test_a_chain_stepped_side_by_side_in_blocks_moves_bit_for_bit_as_alone(threads, integrator):
+    """The short-chain path steps its copies in blocks (``chain.BLOCK``): two full blocks and part of a third, split
+    over the threads, each copy the bits of the articulation alone at 60 Hz and 1 kHz."""
+    art = slide_hinge_chain()
+    for dt in (1 / 60, 1e-3):
+        batch = ArticulationBatch(art, 2 * BLOCK + 22)
+        _spread(art, batch, np.random.default_rng(11))
+        q0, qd0 = batch.q.copy(), batch.qd.copy()
+        with using_threads(min(threads, os.cpu_count() or 1)):
+            batch.step(dt, steps=30, integrator=integrator)
+            batch.step(dt, steps=10, integrator=integrator)
+        for c in (0, BLOCK - 1, BLOCK, 2 * BLOCK + 21):
+            alone = slide_hinge_chain()
+            alone.q, alone.qd = q0[c], qd0[c]
+            for _ in range(40):
+                alone.step(dt, tau=batch.tau[c], integrator=integrator)
+            np.testing.assert_array_equal(batch.q[c], alone.q)
+            np.testing.assert_array_equal(batch.qd[c], alone.qd)
+
+
+@compiled_only("150 copies: minutes as plain Python")
+def test_a_chain_copy_that_blows_up_mid_block_is_named_and_every_copy_keeps_its_state():
+    """A copy that overflows in the middle of a block of the short-chain path: the error names it and its step as the
+    per-copy path does, and no copy moves; without it, the block steps on."""
+    art = slide_hinge_chain()
+    batch = ArticulationBatch(art, 2 * BLOCK + 22)
+    _spread(art, batch, np.random.default_rng(5))
+    before = (batch.q.copy(), batch.qd.copy())
+    batch.qd[BLOCK + 5, 2] = 1e200
+    qd_set = batch.qd.copy()
+    with pytest.raises(SimulationError, match=rf"copy {BLOCK + 5}: link #\d got a non-finite .* at step 0 ") as caught:
+        batch.step(0.01, steps=5, integrator="rk4")
+    assert caught.value.copy == BLOCK + 5
+    np.testing.assert_array_equal(batch.q, before[0])
+    np.testing.assert_array_equal(batch.qd, qd_set)
+    batch.qd[BLOCK + 5, 2] = 0.0
+    batch.step(0.01, steps=5, integrator="rk4")
+    assert np.all(np.isfinite(batch.q)) and batch.time > 0.0
+
+
+# As plain Python the short-chain path's arithmetic is NumPy scalars', which warn of the zero pivot it then discards.
+@pytest.mark.filterwarnings("ignore:divide by zero:RuntimeWarning", "ignore:invalid value:RuntimeWarning")
+def test_a_chain_with_a_massless_end_is_singular_as_on_the_per_copy_path():
+    art = Articulation()
+    hinge = art.add_link(Revolute((0, 1, 0)), mass=1.0, shape_position=(0, 0, -0.5))
+    art.add_link(Prismatic((0, 0, 1)), parent=hinge)  # moves no mass: a zero pivot
+    batch = ArticulationBatch(art, 3)
+    with pytest.raises(SimulationError, match=r"copy 0: link #1 got a singular mass matrix at step 0"):
+        batch.step(0.01, integrator="rk4")
+    with pytest.raises(SimulationError, match=r"singular at degree of freedom 1 \(joint of link #1\)"):
+        art.step(0.01, integrator="rk4")
 
 
 @compiled_only("two threads only matter compiled")

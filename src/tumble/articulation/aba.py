@@ -22,7 +22,7 @@ from __future__ import annotations
 
 from .._jit import inline
 from ..math3d import add, scale
-from .dynamics import SINGULAR_RTOL, joint_force
+from .dynamics import SINGULAR_RTOL, passive_force
 from .model import (
     ACC,
     ARMATURE,
@@ -37,14 +37,38 @@ from .model import (
     VEL,
     VEL_PRODUCT,
 )
-from .spatial import ZERO3, ZERO6, add6, cross_force, dot6, get3, get6, get10, inertia_apply, put6, scale6, sub6, vec3
+from .spatial import (
+    ZERO3,
+    ZERO6,
+    add6,
+    cross_force,
+    dot6,
+    get3,
+    get4,
+    get6,
+    get10,
+    inertia_apply,
+    put6,
+    scale6,
+    sub6,
+    vec3,
+)
 
-__all__ = ["aba"]
+__all__ = [
+    "aba",
+    "add_articulated",
+    "dof_inwards",
+    "dof_outwards",
+    "eliminate_dof",
+    "handed_bias",
+    "link_articulated",
+    "pivot_scale",
+]
 
 _ZERO21 = (0.0,) * 21
 
 
-@inline
+@inline(into_callers=True)
 def _from_inertia(inertia):
     """The 21 numbers of the 6x6 matrix of a spatial inertia ``(m, h, I_O)``: ``A = I_O``, ``B = [h]×``, ``C = m E``."""
     m, hx, hy, hz = inertia[0], inertia[1], inertia[2], inertia[3]
@@ -55,7 +79,7 @@ def _from_inertia(inertia):
     )  # fmt: skip
 
 
-@inline
+@inline(into_callers=True)
 def _apply(a, v):
     """``I^A v`` for the 21-number articulated inertia ``a`` and a spatial vector ``v``."""
     w, x = v[0], v[1]
@@ -72,7 +96,7 @@ def _apply(a, v):
     return (ang, lin)
 
 
-@inline
+@inline(into_callers=True)
 def _downdate(a, u, f):
     """``I^A - f U Uᵀ`` (21 numbers) for the spatial vector ``U``."""
     p, q = u[0], u[1]
@@ -116,7 +140,48 @@ def _external_force(external, i, inertia):
     return (moment, applied)
 
 
-@inline
+@inline(into_callers=True)
+def pivot_scale(largest, own):
+    """The scale of the pivots so far, with a link of spatial inertia ``own``: the largest mass or moment about the
+    origin."""
+    return max(largest, own[0], own[4], own[5], own[6])
+
+
+@inline(into_callers=True)
+def link_articulated(own, vel):
+    """A link's own articulated inertia (21 numbers) and bias force ``v ×_f I v``, before its children's."""
+    return _from_inertia(own), cross_force(vel, inertia_apply(own, vel))
+
+
+@inline(into_callers=True)
+def dof_inwards(inertia, bias, s, params, tau, spring_q, rate):
+    """``(U, D, u)`` of a degree of freedom (motion column ``s``, its row ``params`` of ``dof_params``, force ``tau``,
+    its joint's coordinate ``spring_q`` and its rate) under the articulated inertia and bias so far."""
+    u_vec = _apply(inertia, s)
+    pivot = dot6(s, u_vec) + params[ARMATURE]
+    return u_vec, pivot, tau - passive_force(params, spring_q, rate) - dot6(s, bias)
+
+
+@inline(into_callers=True)
+def eliminate_dof(inertia, bias, u_vec, pivot, u):
+    """``I^A - U Uᵀ / D`` and ``p^A + U u / D``: the degree of freedom made free."""
+    return _downdate(inertia, u_vec, 1.0 / pivot), add6(bias, scale6(u_vec, u / pivot))
+
+
+@inline(into_callers=True)
+def handed_bias(inertia, bias, product):
+    """The bias force a link hands its parent: ``p^A + I^A c`` (``c`` its velocity product)."""
+    return add6(bias, _apply(inertia, product))
+
+
+@inline(into_callers=True)
+def dof_outwards(acc, u_vec, s, pivot, u):
+    """``(q̈, a + S q̈)`` of a degree of freedom from the acceleration ``acc`` so far."""
+    qdd = (u - dot6(u_vec, acc)) / pivot
+    return qdd, add6(acc, scale6(s, qdd))
+
+
+@inline(counted=False)
 def aba(link_ints, world, dof_params, link_work, dof_motion, dof_u, dof_pivot, q, qd, tau, external, use_external,
         qdd):  # fmt: skip
     """``q̈`` (nv,) into ``qdd`` for the joint forces ``tau`` (nv,); returns -1 or the row of a singular pivot.
@@ -131,8 +196,7 @@ def aba(link_ints, world, dof_params, link_work, dof_motion, dof_u, dof_pivot, q
     n, nv = link_ints.shape[0], dof_motion.shape[0]
     largest = 0.0  # the scale of the pivots: the largest mass or moment about the origin
     for i in range(n):
-        largest = max(largest, link_work[i, INERTIA_WORLD], link_work[i, INERTIA_WORLD + 4],
-                      link_work[i, INERTIA_WORLD + 5], link_work[i, INERTIA_WORLD + 6])  # fmt: skip
+        largest = pivot_scale(largest, get10(link_work, i, INERTIA_WORLD))
         link_work[i, ART_STORED] = 0.0
     # inwards: articulated inertias and bias forces, one degree of freedom at a time. A link hands its
     # articulated inertia and bias to its parent in registers when the parent is the next link of the sweep
@@ -143,37 +207,33 @@ def aba(link_ints, world, dof_params, link_work, dof_motion, dof_u, dof_pivot, q
         stop = link_ints[i + 1, V_START] if i + 1 < n else nv
         parent = link_ints[i, PARENT]
         own = get10(link_work, i, INERTIA_WORLD)
-        vel = get6(link_work, i, VEL)
-        inertia, bias = _from_inertia(own), cross_force(vel, inertia_apply(own, vel))
+        inertia, bias = link_articulated(own, get6(link_work, i, VEL))
         if use_external:
             bias = sub6(bias, _external_force(external, i, own))
         if carried_to == i:
-            inertia, bias = _add21(inertia, carried_inertia), add6(bias, carried_bias)
+            inertia, bias = add_articulated(inertia, carried_inertia), add6(bias, carried_bias)
         if link_work[i, ART_STORED] > 0.0:
-            inertia = _add21(inertia, _get21(link_work, i, ART_INERTIA))
+            inertia = add_articulated(inertia, _get21(link_work, i, ART_INERTIA))
             bias = add6(bias, get6(link_work, i, ART_BIAS))
         for k in range(stop - 1, first - 1, -1):
             s = get6(dof_motion, k, 0)
-            u_vec = _apply(inertia, s)
-            pivot = dot6(s, u_vec) + dof_params[k, ARMATURE]
+            spring_q = q[link_ints[i, Q_START] + k - first]
+            u_vec, pivot, u = dof_inwards(inertia, bias, s, get4(dof_params, k, 0), tau[k], spring_q, qd[k])
             if not pivot > SINGULAR_RTOL * largest:
                 return k
-            spring_q = q[link_ints[i, Q_START] + k - first]
-            u = tau[k] - joint_force(dof_params, k, spring_q, qd[k]) - dot6(s, bias)
             put6(dof_u, k, 0, u_vec)
             dof_pivot[k] = pivot
             qdd[k] = u
             if k > first or parent >= 0:
-                inertia = _downdate(inertia, u_vec, 1.0 / pivot)
-                bias = add6(bias, scale6(u_vec, u / pivot))
+                inertia, bias = eliminate_dof(inertia, bias, u_vec, pivot, u)
         carried_to = -1
         if parent < 0:
             continue
-        bias = add6(bias, _apply(inertia, get6(link_work, i, VEL_PRODUCT)))
+        bias = handed_bias(inertia, bias, get6(link_work, i, VEL_PRODUCT))
         if parent == i - 1:
             carried_inertia, carried_bias, carried_to = inertia, bias, parent
         elif link_work[parent, ART_STORED] > 0.0:
-            _put21(link_work, parent, ART_INERTIA, _add21(_get21(link_work, parent, ART_INERTIA), inertia))
+            _put21(link_work, parent, ART_INERTIA, add_articulated(_get21(link_work, parent, ART_INERTIA), inertia))
             put6(link_work, parent, ART_BIAS, add6(get6(link_work, parent, ART_BIAS), bias))
         else:
             _put21(link_work, parent, ART_INERTIA, inertia)
@@ -186,14 +246,14 @@ def aba(link_ints, world, dof_params, link_work, dof_motion, dof_u, dof_pivot, q
         acc = add6(base_acc if parent < 0 else get6(link_work, parent, ACC), get6(link_work, i, VEL_PRODUCT))
         stop = link_ints[i + 1, V_START] if i + 1 < n else nv
         for k in range(link_ints[i, V_START], stop):
-            qdd[k] = (qdd[k] - dot6(get6(dof_u, k, 0), acc)) / dof_pivot[k]
-            acc = add6(acc, scale6(get6(dof_motion, k, 0), qdd[k]))
+            qdd[k], acc = dof_outwards(acc, get6(dof_u, k, 0), get6(dof_motion, k, 0), dof_pivot[k], qdd[k])
         put6(link_work, i, ACC, acc)
     return -1
 
 
-@inline
-def _add21(a, b):
+@inline(into_callers=True)
+def add_articulated(a, b):
+    """The sum of two articulated inertias (21 numbers each)."""
     return (
         a[0] + b[0], a[1] + b[1], a[2] + b[2], a[3] + b[3], a[4] + b[4], a[5] + b[5], a[6] + b[6],
         a[7] + b[7], a[8] + b[8], a[9] + b[9], a[10] + b[10], a[11] + b[11], a[12] + b[12], a[13] + b[13],

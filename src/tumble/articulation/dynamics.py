@@ -44,6 +44,7 @@ from .spatial import (
     cross_force,
     dot6,
     get3,
+    get4,
     get6,
     get10,
     inertia_add,
@@ -87,9 +88,15 @@ def joint_energies(link_ints, dof_params, q, qd):
 def joint_force(dof_params, k, q_value, qd_value):
     """The joint's own force against degree of freedom ``k``: ``damping q̇ + stiffness (q - springref)`` (springs
     only on a hinge or slide, whose coordinate ``q_value`` is its own; elsewhere the stiffness is zero)."""
-    force = dof_params[k, DAMPING] * qd_value
-    if dof_params[k, STIFFNESS] != 0.0:
-        force += dof_params[k, STIFFNESS] * (q_value - dof_params[k, SPRINGREF])
+    return passive_force(get4(dof_params, k, 0), q_value, qd_value)
+
+
+@inline(into_callers=True)
+def passive_force(params, q_value, qd_value):
+    """:func:`joint_force` from the row ``params = (damping, armature, stiffness, springref)`` of ``dof_params``."""
+    force = params[DAMPING] * qd_value
+    if params[STIFFNESS] != 0.0:
+        force += params[STIFFNESS] * (q_value - params[SPRINGREF])
     return force
 
 

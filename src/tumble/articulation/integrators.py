@@ -52,7 +52,7 @@ from .model import (
 )
 from .spatial import assign, fill, fill_matrix, vec3
 
-__all__ = ["DAMPED", "EULER", "NOT_FINITE", "OK", "RK4", "SINGULAR", "SYMPLECTIC", "accelerations", "step"]
+__all__ = ["DAMPED", "EULER", "NOT_FINITE", "OK", "RK4", "SINGULAR", "SYMPLECTIC", "accelerations", "rk4_stage", "step"]
 
 EULER, SYMPLECTIC, RK4, DAMPED = 0, 1, 2, 3
 OK, SINGULAR, NOT_FINITE = 0, 1, 2
@@ -109,7 +109,7 @@ def _dexp_inverse(theta, w):
     return add(add_scaled(w, half, 0.5), scale(cross(theta, half), 1.0 / 12.0))
 
 
-@inline
+@inline(counted=False)
 def _chart_rates(link_ints, v, weight, reach, chart, rate_sum):
     """One RK4 stage in the chart at ``q₀``: its rate ``k = dexp⁻¹_θ(v)`` (``θ = chart``) is added with
     ``weight`` to ``rate_sum``, and the chart point of the next stage, ``reach k``, replaces ``θ``."""
@@ -127,6 +127,13 @@ def _chart_rates(link_ints, v, weight, reach, chart, rate_sum):
             for k in range(3):
                 rate_sum[rotation + k] += weight * rate[k]
                 chart[rotation + k] = reach * rate[k]
+
+
+@inline(into_callers=True)
+def rk4_stage(stage, h):
+    """``(weight, reach)`` of RK4 stage ``stage`` (0 to 3): the stage weights 1, 2, 2, 1; the next stage is reached
+    from the start, ``h/2``, ``h/2`` then ``h`` along."""
+    return (1.0 if stage == 0 or stage == 3 else 2.0), (0.5 * h if stage < 2 else h)
 
 
 @inline
@@ -158,7 +165,7 @@ def _implicit_damping(m, w, qdd, h):
     return -1
 
 
-@inline
+@inline(counted=False)
 def _first_bad_link(link_ints, q, qd):
     """The first link with a non-finite coordinate or velocity, or -1."""
     finite = True
@@ -220,9 +227,7 @@ def step(m, w, q, qd, tau, external, use_external, h, method):
                 # a stage that overflowed makes NaN pivots: report the link, not a singular matrix
                 overflowed = _first_bad_link(link_ints, q_stage, qd_stage)
                 return (NOT_FINITE, overflowed) if overflowed >= 0 else (SINGULAR, bad)
-            # the stage weights 1, 2, 2, 1; the next stage is reached from the start, h/2, h/2 then h along
-            weight = 1.0 if stage == 0 or stage == 3 else 2.0
-            reach = 0.5 * h if stage < 2 else h
+            weight, reach = rk4_stage(stage, h)
             _chart_rates(link_ints, qd_stage, weight, reach, chart, qd_sum)
             for k in range(nv):
                 qdd_sum[k] += weight * qdd[k]

@@ -10,8 +10,11 @@ return status codes that the facade turns into errors.
 
 from __future__ import annotations
 
+import numpy as np
+
 from .._jit import inline, kernel
 from ..math3d import add, cross, dot, scale, sub
+from .chain import chain_steps, serial_chain
 from .constraints import applied_forces
 from .contacts import contact_wrenches, find_contacts
 from .dynamics import crba, joint_energies, rnea
@@ -207,10 +210,25 @@ def batch_kernel(ints, reals, q, qd, tau, work, external, h, method, steps, copi
 
     Returns the number of copies that failed. A copy's arithmetic is :func:`articulation_kernel`'s (the same
     ``step``), so each copy advances bit for bit as the articulation alone: a step reads nothing of the work
-    buffer that it did not write first, so one buffer serves copy after copy (and stays in the cache).
+    buffer that it did not write first, so one buffer serves copy after copy (and stays in the cache). A serial chain
+    of hinges and slides takes the short-chain path (``chain.py``: the same arithmetic, many copies side by side);
+    the blocks of copies it hands back, one of whose copies failed, are stepped here copy by copy.
     """
     m = model_views(ints, reals)
     w = work_views(work, ints[0], ints[1], ints[2], ints[3], ints[4], ints[8], ints[6])
+    if readout.shape[0] == 0 and steps > 0 and serial_chain(m):
+        # the short-chain path (chain.py); the blocks it could not finish are stepped again copy by copy below
+        unfinished = np.empty_like(copies)
+        left = chain_steps(m, q, qd, tau, h, method, steps, copies, unfinished)
+        if left == 0:
+            return 0
+        copies = unfinished[:left]
+    return _step_copies(m, w, q, qd, tau, external, h, method, steps, copies, failures, readout)
+
+
+@inline
+def _step_copies(m, w, q, qd, tau, external, h, method, steps, copies, failures, readout):
+    """:func:`batch_kernel` copy after copy; returns the number that failed."""
     failed = 0
     for c in copies:
         q_c, qd_c, tau_c = q[c], qd[c], tau[c]

@@ -70,12 +70,22 @@ from .spatial import (
     vec4,
 )
 
-__all__ = ["energies", "forward_kinematics", "integrate_configuration", "joint_quat", "quat_exp"]
+__all__ = [
+    "axis_angle_quat",
+    "energies",
+    "forward_kinematics",
+    "integrate_configuration",
+    "joint_quat",
+    "link_inertia",
+    "one_dof_link",
+    "quat_exp",
+]
 
 _REVOLUTE = int(JointType.REVOLUTE)
 _PRISMATIC = int(JointType.PRISMATIC)
 _BALL = int(JointType.BALL)
 _FREE = int(JointType.FREE)
+_NO_TURN = (1.0, 0.0, 0.0, 0.0)
 
 
 @inline
@@ -85,7 +95,8 @@ def joint_quat(q, start):
 
 
 @inline
-def _axis_angle_quat(axis, angle):
+def axis_angle_quat(axis, angle):
+    """The unit quaternion of a turn by ``angle`` about the unit ``axis``."""
     if not math.isfinite(angle):  # as in quat_exp
         return (math.nan, math.nan, math.nan, math.nan)
     s = elementary.sin(0.5 * angle)
@@ -100,7 +111,7 @@ def _rotation_dof(dof_motion, k, pos, a):
     return s
 
 
-@inline
+@inline(counted=False)
 def forward_kinematics(link_ints, link_reals, world, q, qd, link_work, dof_motion):
     """Poses, motion subspaces, velocities, velocity products and spatial inertias of all links.
 
@@ -122,31 +133,22 @@ def forward_kinematics(link_ints, link_reals, world, q, qd, link_work, dof_motio
         axis = get3(link_reals, i, AXIS)
         # the link frame in the parent frame
         rel_pos, rel_quat = get3(link_reals, i, ORIGIN_POS), get4(link_reals, i, ORIGIN_QUAT)
-        if kind == _REVOLUTE:
-            rel_quat = quat_mul(rel_quat, _axis_angle_quat(axis, q[qs]))
-        elif kind == _PRISMATIC:
-            rel_pos = add_scaled(rel_pos, quat_rotate(rel_quat, axis), q[qs])
-        elif kind == _BALL:
+        if kind == _REVOLUTE or kind == _PRISMATIC:
+            turn = axis_angle_quat(axis, q[qs]) if kind == _REVOLUTE else _NO_TURN
+            pos, quat, s, vel, product = one_dof_link(kind, parent_pos, parent_quat, parent_vel, rel_pos, rel_quat,
+                                                      axis, turn, q[qs], qd[vs])  # fmt: skip
+            _store_link(link_reals, link_work, i, pos, quat, vel, product)
+            put6(dof_motion, vs, 0, s)
+            continue
+        if kind == _BALL:
             rel_quat = quat_mul(rel_quat, joint_quat(q, qs))
         elif kind == _FREE:
             rel_pos, rel_quat = (q[qs], q[qs + 1], q[qs + 2]), joint_quat(q, qs + 3)
         quat = quat_mul(parent_quat, rel_quat)
         pos = add(parent_pos, quat_rotate(parent_quat, rel_pos))
-        put3(link_work, i, POS, pos)
-        put4(link_work, i, QUAT, quat)
         # the joint's velocity; its columns fixed in the link turn with the link's velocity
         vel, product = parent_vel, ZERO6
-        if kind == _REVOLUTE:
-            joint_vel = scale6(_rotation_dof(dof_motion, vs, pos, quat_rotate(quat, axis)), qd[vs])
-            vel = add6(vel, joint_vel)
-            product = cross_motion(vel, joint_vel)
-        elif kind == _PRISMATIC:
-            s = (ZERO3, quat_rotate(quat, axis))
-            put6(dof_motion, vs, 0, s)
-            joint_vel = scale6(s, qd[vs])
-            vel = add6(vel, joint_vel)
-            product = cross_motion(vel, joint_vel)
-        elif kind == _BALL or kind == _FREE:
+        if kind == _BALL or kind == _FREE:
             first = vs
             if kind == _FREE:
                 # the linear columns are fixed in the parent: they turn with the parent's velocity
@@ -166,10 +168,43 @@ def forward_kinematics(link_ints, link_reals, world, q, qd, link_work, dof_motio
                 moving_link = add6(moving_link, scale6(s, qd[first + k]))
             vel = add6(vel, moving_link)
             product = add6(product, cross_motion(vel, moving_link))
-        put6(link_work, i, VEL, vel)
-        put6(link_work, i, VEL_PRODUCT, product)
-        inertia = inertia_world(link_reals[i, MASS], get3(link_reals, i, COM), get9(link_reals, i, INERTIA), pos, quat)
-        put10(link_work, i, INERTIA_WORLD, inertia)
+        _store_link(link_reals, link_work, i, pos, quat, vel, product)
+
+
+@inline(into_callers=True)
+def one_dof_link(kind, parent_pos, parent_quat, parent_vel, rel_pos, rel_quat, axis, turn, coordinate, rate):
+    """``(pos, quat, S, vel, product)`` of a link on a hinge (``kind`` revolute, ``turn`` its
+    :func:`axis_angle_quat`) or a slide: the pose, the world-frame motion column, the spatial velocity
+    ``v_λ + S q̇`` and the velocity product ``v ×ₘ S q̇`` (``S`` is fixed in the link and turns with it)."""
+    if kind == _REVOLUTE:
+        rel_quat = quat_mul(rel_quat, turn)
+    else:
+        rel_pos = add_scaled(rel_pos, quat_rotate(rel_quat, axis), coordinate)
+    quat = quat_mul(parent_quat, rel_quat)
+    pos = add(parent_pos, quat_rotate(parent_quat, rel_pos))
+    if kind == _REVOLUTE:
+        a = quat_rotate(quat, axis)
+        s = (a, cross(pos, a))
+    else:
+        s = (ZERO3, quat_rotate(quat, axis))
+    joint_vel = scale6(s, rate)
+    vel = add6(parent_vel, joint_vel)
+    return pos, quat, s, vel, cross_motion(vel, joint_vel)
+
+
+@inline(into_callers=True)
+def link_inertia(link_reals, i, pos, quat):
+    """Link ``i``'s spatial inertia at the pose ``(pos, quat)``."""
+    return inertia_world(link_reals[i, MASS], get3(link_reals, i, COM), get9(link_reals, i, INERTIA), pos, quat)
+
+
+@inline
+def _store_link(link_reals, link_work, i, pos, quat, vel, product):
+    put3(link_work, i, POS, pos)
+    put4(link_work, i, QUAT, quat)
+    put6(link_work, i, VEL, vel)
+    put6(link_work, i, VEL_PRODUCT, product)
+    put10(link_work, i, INERTIA_WORLD, link_inertia(link_reals, i, pos, quat))
 
 
 @inline
@@ -187,7 +222,7 @@ def energies(world, link_work):
     return kinetic, -dot(vec3(world, GRAVITY), first_moment)
 
 
-@inline
+@inline(counted=False)
 def integrate_configuration(link_ints, q, v, h, out):
     """``out = q ⊕ h v``: advance the coordinates ``q`` (nq,) by the velocity ``v`` (nv,) for ``h`` seconds.
 

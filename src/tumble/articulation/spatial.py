@@ -202,7 +202,7 @@ def kinetic_energy(inertia, v):
     return 0.5 * dot6(v, inertia_apply(inertia, v))
 
 
-@inline
+@inline(into_callers=True)
 def inertia_world(mass, com_local, inertia_local, pos, quat):
     """The spatial inertia of a link at pose ``(pos, quat)``.
 
