@@ -121,6 +121,7 @@ class _Copies:
         articulation = task.articulation()
         self.batch = ArticulationBatch(articulation, n)
         self.rngs: list[np.random.Generator | None] = [None] * n
+        self._unseeded = n
         self.elapsed = np.zeros(n, dtype=np.int64)
         self.links = np.zeros((n, len(articulation.links), READOUT_WIDTH)) if task.reads_links else None
         self._method = INTEGRATORS[task.integrator]
@@ -128,19 +129,26 @@ class _Copies:
 
     @property
     def seeded(self) -> bool:
-        return all(rng is not None for rng in self.rngs)
+        return self._unseeded == 0
 
     def seed(self, which: np.ndarray, seeds) -> None:
         """New generators for copies ``which`` (indices) from ``seeds`` (an int or None each)."""
         for i, seed in zip(which, seeds, strict=True):
-            self.rngs[i], _ = seeding.np_random(seed)
+            self.use_generator(i, seeding.np_random(seed)[0])
+
+    def use_generator(self, i: int, rng: np.random.Generator) -> None:
+        """Copy ``i`` draws from ``rng`` from now on."""
+        self._unseeded -= self.rngs[i] is None
+        self.rngs[i] = rng
 
     def reset(self, which: np.ndarray) -> None:
         """Start new episodes in copies ``which`` (int64 indices), each drawn from its own generator; their joint
         forces are zero until the next step, and their links are read at the start if the task reads them."""
-        batch = self.batch
-        for i in which:
-            batch.q[i], batch.qd[i] = self.task.initial_state(self.rngs[i])
+        batch, initial_state, rngs = self.batch, self.task.initial_state, self.rngs
+        starts = [initial_state(rngs[i]) for i in which]  # one Python call a copy: its own generator
+        if starts:
+            batch.q[which] = [q for q, _ in starts]
+            batch.qd[which] = [qd for _, qd in starts]
         batch.tau[which] = 0.0
         self.elapsed[which] = 0
         if self.links is not None:
@@ -207,7 +215,7 @@ class TumbleEnv(gym.Env):
 
     def reset(self, *, seed=None, options=None):
         super().reset(seed=seed)
-        self._copies.rngs[0] = self.np_random
+        self._copies.use_generator(0, self.np_random)  # Env.reset made it from seed, or kept the one it had
         self._copies.reset(np.zeros(1, dtype=np.int64))
         return self._copies.observe()[0], _first(self._copies.reset_info(slice(0, 1)))
 

@@ -94,10 +94,13 @@ class DoublePendulumTask(Task):
             POLE * (portable.cos(first) + portable.cos(second)),
         )
 
+    def outcome(self, start, actions, q, qd, links):
+        x, y = self.tip(q)  # once for both
+        terminated = y <= 1.0
+        return _reward(x, y, qd, terminated), terminated, {}
+
     def reward(self, q0, qd0, actions, q, qd, terminated):
-        x, y = self.tip(q)
-        alive = np.where(terminated, 0.0, 10.0)
-        return alive - (0.01 * x**2 + (y - 2.0) ** 2) - (1e-3 * qd[:, 1] ** 2 + 5e-3 * qd[:, 2] ** 2)
+        return _reward(*self.tip(q), qd, terminated)
 
     def terminated(self, q, qd):
         return self.tip(q)[1] <= 1.0
@@ -113,3 +116,9 @@ class DoublePendulumTask(Task):
         canvas.segment((q[0], 0.0), elbow, 0.09, (0, 179, 179))
         canvas.segment(elbow, tip, 0.09, (0, 179, 179))
         return canvas.image
+
+
+def _reward(x, y, qd, terminated):
+    """10 while alive, less the tip's distance from (0, 2) and the poles' speeds (InvertedDoublePendulum-v5's)."""
+    alive = np.where(terminated, 0.0, 10.0)
+    return alive - (0.01 * x**2 + (y - 2.0) ** 2) - (1e-3 * qd[:, 1] ** 2 + 5e-3 * qd[:, 2] ** 2)
