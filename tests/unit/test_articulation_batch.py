@@ -10,7 +10,8 @@ import pytest
 from compiled import compiled_only
 from tumble import SimulationError
 from tumble.articulation import Articulation, ArticulationBatch, Ball, Free, Prismatic, Revolute
-from tumble.articulation.chain import BLOCK
+from tumble.articulation.chain import BLOCK, serial_chain
+from tumble.articulation.model import model_views, python_function
 from tumble.dynamics.integrate import using_threads
 from tumble.mass import MassProperties
 from tumble.shapes import Box
@@ -95,6 +96,32 @@ def test_every_copy_moves_bit_for_bit_as_the_articulation_alone(build, integrato
         np.testing.assert_array_equal(batch.q[c], alone.q)
         np.testing.assert_array_equal(batch.qd[c], alone.qd)
     assert np.ptp(batch.q[:, -1]) > 0.0  # the copies differ
+
+
+def _branched() -> Articulation:
+    art = Articulation()
+    root = art.add_link(Revolute((0, 1, 0)), mass=1.0, shape_position=(0, 0, -0.5))
+    for side in (-1.0, 1.0):
+        art.add_link(Revolute((1, 0, 0)), parent=root, position=(side, 0, -1), mass=0.5, shape_position=(0, 0, -0.3))
+    return art
+
+
+def _limited() -> Articulation:
+    art = cart_pole()
+    art.add_link(Revolute((0, 1, 0)), parent=1, position=(0, 0, 1), mass=0.1, shape_position=(0, 0, 0.2),
+                 limits=(-0.5, 0.5))  # fmt: skip
+    return art
+
+
+@pytest.mark.parametrize(
+    ("build", "takes_it"),
+    [(cart_pole, True), (slide_hinge_chain, True), (ball_chain, False), (four_bar, False), (free_body, False),
+     (_branched, False), (_limited, False)],
+)  # fmt: skip
+def test_the_short_chain_path_takes_serial_chains_of_hinges_and_slides_with_nothing_to_solve(build, takes_it):
+    compiled = build()._compile()
+    model = python_function(model_views)(compiled.ints, compiled.reals)
+    assert python_function(serial_chain)(model) is takes_it
 
 
 @compiled_only("150 copies over 40 steps: minutes as plain Python")

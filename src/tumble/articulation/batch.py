@@ -14,14 +14,18 @@ from .._validate import _show, all_finite, as_array, as_count, as_step, require_
 from ..dynamics.integrate import thread_pool, threads
 from ..errors import SimulationError
 from .articulation import Articulation, _check_integrator, unit_quaternions
-from .integrators import NOT_FINITE
+from .chain import serial_chain
+from .integrators import DAMPED, NOT_FINITE
 from .kernels import READOUT_WIDTH, batch_kernel
-from .model import counts, work_size
+from .model import counts, model_views, python_function, work_size
 
 __all__ = ["ArticulationBatch"]
 
-# Below this many copy-steps a call stays on the calling thread: a hand-off to the pool costs ~20 µs.
+# Below this many copy-steps a call stays on the calling thread: a hand-off to the pool and back costs 20-200 µs. A
+# copy-step of the short-chain path (chain.py) costs a tenth of the per-copy path's, so it needs ten times as many
+# (1024 cart-poles, one step: 0.2 ms on one thread, 0.3 ms on two).
 _PARALLEL_MIN_STEPS = 256
+_CHAIN_PARALLEL_MIN_STEPS = 4096
 _NO_READOUT = np.zeros((0, 0, READOUT_WIDTH))
 
 
@@ -67,6 +71,7 @@ class ArticulationBatch:
         need = 8.0 * n * (nq + 2 * nv + 3)
         require_memory(need, f"n={n} copies of a {nq}-coordinate articulation", "use fewer copies")
         self._work_size = work_size(links, nq, nv, loops, scalars, contacts, geoms)
+        self._serial_chain = python_function(serial_chain)(python_function(model_views)(self._ints, self._reals))
         self._work = np.zeros((1, self._work_size))  # one work buffer per thread, grown as threads are used
         self._external = np.zeros((links, 6))
         self._failures = np.zeros((n, 3), dtype=np.int64)
@@ -143,7 +148,9 @@ class ArticulationBatch:
         readout = _NO_READOUT if readout is None else readout
         before = (self._q.copy(), self._qd.copy())
         workers = min(threads(), len(copies))
-        if workers < 2 or len(copies) * max(steps, 1) < _PARALLEL_MIN_STEPS:
+        chain = self._serial_chain and readout.shape[0] == 0 and method != DAMPED
+        least = _CHAIN_PARALLEL_MIN_STEPS if chain else _PARALLEL_MIN_STEPS
+        if workers < 2 or len(copies) * max(steps, 1) < least:
             failed = batch_kernel(self._ints, self._reals, self._q, self._qd, self._tau, self._work[0], self._external,
                                   dt, method, steps, copies, self._failures, readout)  # fmt: skip
         else:
