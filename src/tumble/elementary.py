@@ -23,7 +23,7 @@ import math
 
 from ._jit import inline
 
-__all__ = ["acos", "asin", "atan", "atan2", "cos", "exp", "sin"]
+__all__ = ["SIN_COS_RANGE", "acos", "asin", "atan", "atan2", "cos", "exp", "sin", "sin_cos"]
 
 _HALF_PI = math.pi / 2.0
 _QUARTER_PI = math.pi / 4.0
@@ -79,9 +79,31 @@ def _reduce(x):
     """``(r, k mod 4)`` with ``x = k π/2 + r`` and ``|r| <= π/4`` (to rounding)."""
     if abs(x) > _REDUCE_LIMIT:
         x = x % _TWO_PI
+    r, quadrant = _reduce_near(x)
+    return r, int(quadrant)
+
+
+@inline(into_callers=True)
+def _reduce_near(x):
+    """:func:`_reduce` for ``|x| <= SIN_COS_RANGE``, the quadrant as a float."""
     k = math.floor(x * _TWO_OVER_PI + 0.5)
     r = ((x - k * _PI2_A) - k * _PI2_B) - k * _PI2_C
-    return r, int(k - 4.0 * math.floor(0.25 * k))
+    return r, k - 4.0 * math.floor(0.25 * k)
+
+
+SIN_COS_RANGE = _REDUCE_LIMIT
+
+
+@inline(into_callers=True)
+def sin_cos(x):
+    """``(sin(x), cos(x))``, the bits of :func:`sin` and :func:`cos`, for a finite ``|x| <= SIN_COS_RANGE`` (the
+    caller checks; beyond, the result means nothing). One reduction for both, and the quadrant picks by selects, not
+    branches, so that a loop of them over many ``x`` vectorises (``articulation/chain.py``)."""
+    r, quadrant = _reduce_near(x)
+    s, c = _sin_reduced(r), _cos_reduced(r)
+    sine = s if quadrant == 0.0 else (c if quadrant == 1.0 else (-s if quadrant == 2.0 else -c))
+    cosine = c if quadrant == 0.0 else (-s if quadrant == 1.0 else (-c if quadrant == 2.0 else s))
+    return (x if abs(x) < 1e-8 else sine), cosine
 
 
 @inline

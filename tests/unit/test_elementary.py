@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 from tumble import elementary, portable
+from tumble._jit import kernel
 
 mpmath.mp.prec = 120
 RNG = np.random.default_rng(44)
@@ -97,6 +98,30 @@ def test_compiled_loops_give_the_bits_of_the_python_source():
             scalar.__name__
         )
     assert isinstance(portable.sin(0.5), np.floating) and portable.sin(np.zeros((2, 3))).shape == (2, 3)
+
+
+@kernel
+def _sin_cos_loop(x, out):
+    """elementary.sin_cos over an array, in a loop LLVM vectorises, beside the branching sin and cos."""
+    for i in range(x.shape[0]):
+        out[0, i], out[1, i] = elementary.sin_cos(x[i])
+    for i in range(x.shape[0]):
+        out[2, i], out[3, i] = elementary.sin(x[i]), elementary.cos(x[i])
+
+
+def test_sin_cos_gives_the_bits_of_sin_and_cos_over_its_range():
+    """The branch-free pair (one reduction, the quadrant by selects) is sin and cos to the bit, in Python and
+    compiled, from the sub-1e-8 shortcut of sin to SIN_COS_RANGE, at the quadrants' edges and at zeros of either
+    sign."""
+    edges = np.arange(-40, 41) * (math.pi / 4)
+    x = np.concatenate([_log_uniform(-12, 6, 4000), edges, np.nextafter(edges, 0.0), np.nextafter(edges, 10.0),
+                        [0.0, -0.0, 1e-8, -1e-8, elementary.SIN_COS_RANGE, -elementary.SIN_COS_RANGE]])  # fmt: skip
+    x = x[np.abs(x) <= elementary.SIN_COS_RANGE]
+    out = np.zeros((4, x.size))
+    _sin_cos_loop(x, out)
+    assert out[0].tobytes() == out[2].tobytes() and out[1].tobytes() == out[3].tobytes()
+    python = np.array([elementary.sin_cos(float(v)) for v in x]).T
+    assert python.tobytes() == out[:2].tobytes()
 
 
 def test_products_inverses_and_principal_axes_agree_with_numpy():

@@ -31,12 +31,13 @@ import math
 import numpy as np
 
 from .._jit import inline
+from ..elementary import SIN_COS_RANGE
 from ..math3d import scale
 from .aba import add_articulated, dof_inwards, dof_outwards, eliminate_dof, handed_bias, link_articulated, pivot_scale
 from .dynamics import SINGULAR_RTOL
 from .integrators import EULER, RK4, SYMPLECTIC, rk4_stage
 from .joints import JointType
-from .kinematics import axis_angle_quat, one_dof_link
+from .kinematics import axis_angle_quat, axis_angle_quat_near, one_dof_link
 from .model import AXIS, BASE_POS, BASE_QUAT, COM, GRAVITY, JOINT, MASS, ORIGIN_POS, ORIGIN_QUAT, PARENT
 from .model import INERTIA as INERTIA_LOCAL
 from .spatial import ZERO6, add6, get3, get4, get9, inertia_world, vec3, vec4
@@ -138,7 +139,15 @@ def _put21(lanes, row, c, v):
 # LLVM from vectorising it), in a function of its own so that nothing it computes outlives it.
 @inline(into_callers=True, ieee_division=True)
 def _turns(pair, b, axis):
-    """A hinge's turn of each copy: ``elementary``'s sin and cos branch on the quadrant, so this loop stays scalar."""
+    """A hinge's turn of each copy (``kinematics.axis_angle_quat``): branch-free (``elementary.sin_cos``), which
+    vectorises, when every angle of the block is in its range, else copy by copy."""
+    near = True
+    for c in range(b):
+        near = near and abs(0.5 * pair[(OWN + Q_STAGE) * BLOCK + c]) <= SIN_COS_RANGE  # false for inf and NaN
+    if near:
+        for c in range(b):
+            _put4(pair, OWN + TURN, c, axis_angle_quat_near(axis, pair[(OWN + Q_STAGE) * BLOCK + c]))
+        return
     for c in range(b):
         _put4(pair, OWN + TURN, c, axis_angle_quat(axis, pair[(OWN + Q_STAGE) * BLOCK + c]))
 

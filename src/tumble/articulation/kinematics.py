@@ -72,6 +72,7 @@ from .spatial import (
 
 __all__ = [
     "axis_angle_quat",
+    "axis_angle_quat_near",
     "energies",
     "forward_kinematics",
     "integrate_configuration",
@@ -101,6 +102,14 @@ def axis_angle_quat(axis, angle):
         return (math.nan, math.nan, math.nan, math.nan)
     s = elementary.sin(0.5 * angle)
     return (elementary.cos(0.5 * angle), axis[0] * s, axis[1] * s, axis[2] * s)
+
+
+@inline(into_callers=True)
+def axis_angle_quat_near(axis, angle):
+    """:func:`axis_angle_quat` for a finite ``|angle| <= 2 elementary.SIN_COS_RANGE``, the same bits without a
+    branch (``elementary.sin_cos``): for loops over many copies that vectorise."""
+    s, c = elementary.sin_cos(0.5 * angle)
+    return (c, axis[0] * s, axis[1] * s, axis[2] * s)
 
 
 @inline
