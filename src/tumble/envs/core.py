@@ -179,14 +179,15 @@ class _Copies:
             copies = np.arange(batch.n, dtype=np.int64)[which]
             batch._advance(self._h, 0, self._method, copies=np.atleast_1d(copies), readout=self.links)
 
-    def step(self, actions: np.ndarray):
-        """One control step of every copy: ``(observations, rewards, terminated, elapsed steps, info)``."""
+    def step(self, actions: np.ndarray, moving=None):
+        """One control step: ``(observations, rewards, terminated, elapsed steps, info)`` of every copy, of which only
+        ``moving`` (int64 indices; all by default) take the physics steps (the others restart after it)."""
         task, batch = self.task, self.batch
         start = None
         if task.reward_reads_start:
             start = (batch.q.copy(), batch.qd.copy(), None if self.links is None else self.links.copy())
         acting = task.prepare(actions, batch.q, batch.qd, batch.tau)
-        batch._advance(self._h, task.substeps, self._method, readout=self.links)
+        batch._advance(self._h, task.substeps, self._method, copies=moving, readout=self.links)
         self.elapsed += 1
         rewards, terminated, info = task.outcome(start, acting, batch.q, batch.qd, self.links)
         return self.observe(), rewards, terminated, self.elapsed, info
@@ -309,7 +310,8 @@ class TumbleVectorEnv(VectorEnv):
             raise ValueError(f"actions must have {self.num_envs} rows (one per copy), got shape {actions.shape}")
         restarting = np.flatnonzero(self._autoreset).astype(np.int64)
         copies = self._copies
-        observations, rewards, terminated, elapsed, info = copies.step(actions)
+        moving = np.flatnonzero(~self._autoreset).astype(np.int64) if len(restarting) else None  # the others restart
+        observations, rewards, terminated, elapsed, info = copies.step(actions, moving)
         truncated = elapsed >= self.max_episode_steps
         infos = _masked(info, ~self._autoreset)
         if len(restarting):
