@@ -53,7 +53,7 @@ BOUNDSCHECK_TESTS := tests/unit/test_gjk.py tests/unit/test_collide_convex.py te
 	tests/analytic/test_shipped_scenes.py::test_the_mixed_pile_runs_12_s_at_240_hz_past_its_old_crash \
 	tests/analytic/test_native_flight.py tests/analytic/test_sensors.py \
 	tests/peers/test_mjcf_joint_physics.py tests/peers/test_mjcf_contacts.py tests/peers/test_locomotion_envs.py \
-	tests/analytic/test_articulation_readout.py
+	tests/analytic/test_articulation_readout.py tests/unit/test_articulation_batch.py tests/unit/test_elementary.py
 
 # The tests marked slow (every shipped scene at every rate, the long scenes), then the bounds-checked pass. Numba's
 # cache does not tell a bounds-checked build from a plain one, so that pass compiles into a cache of its own.
