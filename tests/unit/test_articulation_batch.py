@@ -147,6 +147,33 @@ def test_a_chain_stepped_side_by_side_in_blocks_moves_bit_for_bit_as_alone(threa
             np.testing.assert_array_equal(batch.qd[c], alone.qd)
 
 
+@compiled_only("a 20-link chain's copies over 20 steps: minutes as plain Python")
+@pytest.mark.parametrize("dt", [1 / 240, 1e-3])
+def test_a_long_chain_on_the_short_chain_path_keeps_its_bits(dt):
+    """Twenty links (the block's rows grow with the chain, 60 kB a link): copies in a full and a part block, each the
+    bits of the articulation alone, at 240 Hz and 1 kHz."""
+
+    def long_chain() -> Articulation:
+        art, link = Articulation(), None
+        for i in range(20):
+            joint = Revolute((0.1, 1.0, 0.2)) if i % 3 else Prismatic((1.0, 0.0, 0.3))
+            link = art.add_link(joint, parent=link, position=(0, 0, 0) if link is None else (0, 0, -0.3), mass=1.0,
+                                shape_position=(0.05, 0, -0.15), damping=0.01 * i)  # fmt: skip
+        return art
+
+    batch = ArticulationBatch(long_chain(), BLOCK + 6)
+    batch.q[:] = np.random.default_rng(20).uniform(-0.3, 0.3, batch.q.shape)
+    q0 = batch.q.copy()
+    batch.step(dt, steps=20, integrator="rk4")
+    for c in (0, BLOCK - 1, BLOCK + 5):
+        alone = long_chain()
+        alone.q = q0[c]
+        for _ in range(20):
+            alone.step(dt, integrator="rk4")
+        np.testing.assert_array_equal(batch.q[c], alone.q)
+        np.testing.assert_array_equal(batch.qd[c], alone.qd)
+
+
 @compiled_only("150 copies: minutes as plain Python")
 def test_a_chain_copy_that_blows_up_mid_block_is_named_and_every_copy_keeps_its_state():
     """A copy that overflows in the middle of a block of the short-chain path: the error names it and its step as the

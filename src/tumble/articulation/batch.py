@@ -148,6 +148,7 @@ class ArticulationBatch:
         readout = _NO_READOUT if readout is None else readout
         before = (self._q.copy(), self._qd.copy())
         workers = min(threads(), len(copies))
+        # chain.takes_short_chain, with the model's part asked once when the batch was built
         chain = self._serial_chain and readout.shape[0] == 0 and method != DAMPED
         least = _CHAIN_PARALLEL_MIN_STEPS if chain else _PARALLEL_MIN_STEPS
         if workers < 2 or len(copies) * max(steps, 1) < least:

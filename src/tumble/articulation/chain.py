@@ -42,7 +42,7 @@ from .model import AXIS, BASE_POS, BASE_QUAT, COM, GRAVITY, JOINT, MASS, ORIGIN_
 from .model import INERTIA as INERTIA_LOCAL
 from .spatial import ZERO6, add6, get3, get4, get9, inertia_world, vec3, vec4
 
-__all__ = ["BLOCK", "chain_steps", "serial_chain"]
+__all__ = ["BLOCK", "chain_steps", "serial_chain", "takes_short_chain"]
 
 BLOCK = 64  # copies side by side: a three-link chain's block (300 kB) stays in the L2 cache; 32 or 128 run slower
 _REVOLUTE = int(JointType.REVOLUTE)
@@ -60,6 +60,13 @@ Q, QD, TAU, Q_START, QD_START, Q_STAGE, QD_STAGE, QDD, QDD_SUM, QD_SUM, CHART = 
 ARTICULATED = 92  # the articulated inertia (21) and bias (6) of the link and its subtree so far
 LINK_ROWS = 119
 GROUP, OWN = LINK_ROWS * BLOCK, LINK_ROWS  # a group's numbers; the row of the second group of a view of two
+
+
+@inline
+def takes_short_chain(m, method, reading):
+    """Whether ``batch_kernel`` steps the copies here: a :func:`serial_chain`, an explicit integrator (not MuJoCo's
+    implicit damping), and no readout (``reading``)."""
+    return not reading and (method == EULER or method == SYMPLECTIC or method == RK4) and serial_chain(m)
 
 
 @inline
@@ -348,10 +355,6 @@ def chain_steps(m, q, qd, tau, h, method, steps, copies, unfinished):
     forces ``tau`` (held), in blocks of :data:`BLOCK`. A block in which a copy meets a singular pivot or a non-finite
     value is left as it was, its copies written to the front of ``unfinished``; returns how many there are."""
     n = m.link_ints.shape[0]
-    if method != RK4 and method != SYMPLECTIC and method != EULER:
-        for j in range(copies.shape[0]):
-            unfinished[j] = copies[j]
-        return copies.shape[0]
     lanes = np.zeros((n + 2) * GROUP)  # the base, the links, and an empty child of the last
     left = 0
     for start in range(0, copies.shape[0], BLOCK):

@@ -14,7 +14,7 @@ import numpy as np
 
 from .._jit import inline, kernel
 from ..math3d import add, cross, dot, scale, sub
-from .chain import chain_steps, serial_chain
+from .chain import chain_steps, takes_short_chain
 from .constraints import applied_forces
 from .contacts import contact_wrenches, find_contacts
 from .dynamics import crba, joint_energies, rnea
@@ -216,7 +216,7 @@ def batch_kernel(ints, reals, q, qd, tau, work, external, h, method, steps, copi
     """
     m = model_views(ints, reals)
     w = work_views(work, ints[0], ints[1], ints[2], ints[3], ints[4], ints[8], ints[6])
-    if readout.shape[0] == 0 and steps > 0 and serial_chain(m):
+    if steps > 0 and takes_short_chain(m, method, readout.shape[0] > 0):
         # the short-chain path (chain.py); the blocks it could not finish are stepped again copy by copy below
         unfinished = np.empty_like(copies)
         left = chain_steps(m, q, qd, tau, h, method, steps, copies, unfinished)
