@@ -381,3 +381,20 @@ def test_ensemble_rows_for_the_pool_and_dask_with_their_efficiency():
     assert all(r["members"] == 4 and r["members_per_s"] > 0 for r in rows if "scaling" not in r["executor"])
     assert all("efficiency" in r for r in rows if r["workers"] == 2 and "scaling" not in r["executor"])
     assert [r["members"] for r in rows if "scaling" in r["executor"]] == [2, 4]
+
+
+@pytest.mark.slow  # 10 s on a fresh clone: the profile compiles its own copy of each stage, which the warmup does not
+def test_the_contact_profile_replays_the_batch_step_to_its_bits_stage_by_stage():
+    from benchmarks import contact_profile
+
+    whole = contact_profile.profile(contact_profile.ProfileSizes(copies=2, boxes=4, steps=6))
+    split = contact_profile.profile(contact_profile.QUICK)
+    for result in (whole, split):
+        assert result["same_bits"]  # the replay is pipeline.contact_stages, stage for stage
+        assert all(seconds >= 0.0 for seconds in result["stages"].values())
+        lines = contact_profile.table(result)
+        assert lines[-1].startswith("| all stages |") and len(lines) == len(result["stages"]) + 3
+    assert "run_substeps" in whole["stages"] and "solve_contacts" not in whole["stages"]
+    assert {"solve_contacts", "relax_contacts", "warm_start_contacts"} <= set(split["stages"])
+    assert "run_substeps" not in split["stages"]
+    assert split["per_step"]["found_again"] > 0 and "rebase_contacts" in split["stages"]
