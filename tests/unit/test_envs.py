@@ -10,12 +10,14 @@ import pytest
 
 gym = pytest.importorskip("gymnasium")
 
+from gymnasium.utils import seeding  # noqa: E402
 from gymnasium.utils.env_checker import check_env  # noqa: E402
 from gymnasium.vector import AutoresetMode  # noqa: E402
 
 import tumble.envs  # noqa: E402
 from tumble.envs import TASKS, TumbleEnv, TumbleVectorEnv, make_env, make_vector_env  # noqa: E402
 from tumble.models.mjcf import MJCFError  # noqa: E402
+from tumble.rotation import quat_from_rotvec  # noqa: E402
 from tumble.vehicles import rotor_hubs  # noqa: E402
 
 NAMES = tuple(TASKS)
@@ -364,3 +366,50 @@ def test_locomotion_arguments_and_actions_are_checked():
     np.testing.assert_array_equal(env.state[0], before[0])
     _, reward, _, _, info = env.step(np.full(3, 2.0, dtype=np.float32))  # clipped to ±1 for the motors, not the cost
     assert info["reward_ctrl"] == pytest.approx(-0.5 * 3 * 4.0)
+
+
+def _gymnasium_style_start(task, rng):
+    """``(q, qd)`` drawn as Gymnasium's own envs draw a start: ``rng.uniform`` and ``rng.standard_normal`` calls."""
+    name = type(task).__name__
+    if name == "CartPoleTask":
+        start = rng.uniform(-0.05, 0.05, size=4)
+        return start[0::2], start[1::2]
+    if name == "PendulumTask":
+        start = rng.uniform((-math.pi, -1.0), (math.pi, 1.0), size=2)
+        return start[:1], start[1:]
+    if name == "DoublePendulumTask":
+        return rng.uniform(-0.1, 0.1, size=3), 0.1 * rng.standard_normal(3)
+    if name == "QuadrotorHoverTask":
+        start = rng.uniform(np.repeat((-0.5, -0.2, -0.5, -0.2), 3), np.repeat((0.5, 0.2, 0.5, 0.2), 3), size=12)
+        return np.concatenate([start[:3], quat_from_rotvec(start[3:6])]), start[6:]
+    noise, nv = task.reset_noise_scale, task.init_qd.shape[0]
+    q = task.init_q + rng.uniform(-noise, noise, size=task.init_q.shape[0])
+    if task.uniform_velocity_noise:
+        return q, task.init_qd + rng.uniform(-noise, noise, size=nv)
+    return q, task.init_qd + noise * rng.standard_normal(nv)
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_a_start_is_the_generators_own_uniform_and_normal_draws_bit_for_bit(name):
+    """Starts are drawn a copy at a time as standard draws and mapped for all copies at once: the same bits as
+    ``rng.uniform(low, high)`` and ``scale * rng.standard_normal()`` of the copy's generator, seeded or continued."""
+    env = make_env(name)
+    for seed in (0, 1, 2024):
+        rng = seeding.np_random(seed)[0]
+        env.reset(seed=seed)
+        for _ in range(3):  # the seeded start, then starts that continue the copy's generator
+            q, qd = _gymnasium_style_start(env.task, rng)
+            np.testing.assert_array_equal(env.state[0], q)
+            np.testing.assert_array_equal(env.state[1], qd)
+            env.reset()
+
+
+def test_start_draws_of_an_unknown_kind_are_refused_with_the_task_named():
+    class Lopsided(TASKS["Pendulum"]):
+        start_draws = (("gaussian", 2),)
+
+    with pytest.raises(ValueError, match=r"Lopsided.start_draws entries must be \(kind, count\).*'gaussian', 2"):
+        TumbleVectorEnv(Lopsided(), 2)
+    Lopsided.start_draws = (("uniform", 0),)
+    with pytest.raises(ValueError, match="a positive count, got \\('uniform', 0\\)"):
+        TumbleEnv(Lopsided())

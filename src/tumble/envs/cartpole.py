@@ -33,7 +33,7 @@ from gymnasium import spaces
 from ..articulation import Articulation, Prismatic, Revolute
 from ..mass import MassProperties
 from .canvas import Canvas
-from .core import Task
+from .core import Task, uniform
 
 __all__ = ["CartPoleTask"]
 
@@ -62,9 +62,11 @@ class CartPoleTask(Task):
         art.add_link(Revolute((0.0, 1.0, 0.0)), parent=cart, mass_properties=pole, name="pole")
         return art
 
-    def initial_state(self, rng):
-        start = rng.uniform(-0.05, 0.05, size=4)  # (x, ẋ, θ, θ̇)
-        return start[0::2], start[1::2]
+    start_draws = (("uniform", 4),)  # (x, ẋ, θ, θ̇)
+
+    def start(self, draws):
+        start = uniform(draws, -0.05, 0.05)
+        return start[:, 0::2], start[:, 1::2]
 
     def prepare(self, actions, q, qd, tau):
         pushes = np.asarray(actions).reshape(-1)

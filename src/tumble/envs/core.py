@@ -30,7 +30,7 @@ from ..articulation import Articulation, ArticulationBatch
 from ..articulation.articulation import INTEGRATORS
 from ..articulation.kernels import READOUT_WIDTH
 
-__all__ = ["Task", "TumbleEnv", "TumbleVectorEnv"]
+__all__ = ["Task", "TumbleEnv", "TumbleVectorEnv", "uniform"]
 
 RENDER_MODES = ("rgb_array",)
 
@@ -51,13 +51,19 @@ class Task:
     reads_links = False  # whether observe() and outcome() read the links' readout (else they get None)
     observation_space: gym.Space
     action_space: gym.Space
+    # A copy's start as the standard draws it takes from its own generator, in order: ("uniform", n) takes n
+    # uniforms in [0, 1), ("normal", n) n standard normals. Drawn a copy at a time (each copy has its generator),
+    # they are mapped by start() for every restarting copy at once, which costs a copy two short calls, not a
+    # Python method of array arithmetic.
+    start_draws: tuple[tuple[str, int], ...] = ()
 
     def articulation(self) -> Articulation:
         """The robot, built fresh."""
         raise NotImplementedError
 
-    def initial_state(self, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
-        """``(q, qd)``, (nq,) and (nv,), of a copy starting an episode, drawn from its generator ``rng``."""
+    def start(self, draws: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """``(q, qd)``, (copies, nq) and (copies, nv), of copies starting an episode: their :attr:`start_draws`
+        (copies, total count), mapped all at once (see :func:`uniform`)."""
         raise NotImplementedError
 
     def prepare(self, actions: np.ndarray, q: np.ndarray, qd: np.ndarray, tau: np.ndarray) -> np.ndarray:
@@ -97,6 +103,30 @@ class Task:
         raise NotImplementedError
 
 
+def uniform(unit: np.ndarray, low, high) -> np.ndarray:
+    """Uniform draws in ``[low, high)`` from standard ones ``unit`` in [0, 1): ``low + (high - low) unit``, the
+    arithmetic of NumPy's ``Generator.uniform`` (``random_uniform`` in numpy/random/src/distributions), so a
+    start equals ``rng.uniform(low, high)`` of the same generator bit for bit."""
+    low, high = np.asarray(low, dtype=np.float64), np.asarray(high, dtype=np.float64)
+    return low + (high - low) * unit
+
+
+_DRAWS = {"uniform": "random", "normal": "standard_normal"}  # a start draw's kind: its Generator method
+
+
+def _draw_plan(task: Task) -> tuple[list[tuple[str, int, int]], int]:
+    """``([(Generator method, first column, end column)], total columns)`` of the task's ``start_draws``."""
+    plan, total = [], 0
+    for entry in task.start_draws:
+        kind, count = entry if isinstance(entry, tuple) and len(entry) == 2 else (None, None)
+        if kind not in _DRAWS or isinstance(count, bool) or not isinstance(count, numbers.Integral) or count < 1:
+            raise ValueError(f"{type(task).__name__}.start_draws entries must be (kind, count) with kind in "
+                             f"{sorted(_DRAWS)} and a positive count, got {entry!r}")  # fmt: skip
+        plan.append((_DRAWS[kind], total, total + int(count)))
+        total += int(count)
+    return plan, total
+
+
 def _check_render_mode(render_mode) -> str | None:
     if render_mode is not None and render_mode not in RENDER_MODES:
         raise ValueError(f"render_mode must be None or one of {RENDER_MODES}, got {render_mode!r}")
@@ -126,6 +156,7 @@ class _Copies:
         self.links = np.zeros((n, len(articulation.links), READOUT_WIDTH)) if task.reads_links else None
         self._method = INTEGRATORS[task.integrator]
         self._h = task.dt / task.substeps
+        self._draws, self._draw_count = _draw_plan(task)
 
     @property
     def seeded(self) -> bool:
@@ -144,11 +175,14 @@ class _Copies:
     def reset(self, which: np.ndarray) -> None:
         """Start new episodes in copies ``which`` (int64 indices), each drawn from its own generator; their joint
         forces are zero until the next step, and their links are read at the start if the task reads them."""
-        batch, initial_state, rngs = self.batch, self.task.initial_state, self.rngs
-        starts = [initial_state(rngs[i]) for i in which]  # one Python call a copy: its own generator
-        if starts:
-            batch.q[which] = [q for q, _ in starts]
-            batch.qd[which] = [qd for _, qd in starts]
+        batch, rngs, plan = self.batch, self.rngs, self._draws
+        if len(which):
+            draws = np.empty((len(which), self._draw_count))
+            for row, i in zip(draws, which, strict=True):  # a copy at a time: each draws from its own generator
+                rng = rngs[i]
+                for method, first, end in plan:
+                    getattr(rng, method)(out=row[first:end])
+            batch.q[which], batch.qd[which] = self.task.start(draws)
         batch.tau[which] = 0.0
         self.elapsed[which] = 0
         if self.links is not None:

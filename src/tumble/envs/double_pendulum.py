@@ -43,7 +43,7 @@ from .. import elementary, portable
 from ..articulation import Articulation, Prismatic, Revolute
 from ..shapes import Capsule
 from .canvas import Canvas
-from .core import Task
+from .core import Task, uniform
 
 __all__ = ["DoublePendulumTask"]
 
@@ -72,8 +72,10 @@ class DoublePendulumTask(Task):
                      shape_position=(0.0, 0.0, POLE / 2), damping=DAMPING, name="pole2")  # fmt: skip
         return art
 
-    def initial_state(self, rng):
-        return rng.uniform(-0.1, 0.1, size=3), 0.1 * rng.standard_normal(3)
+    start_draws = (("uniform", 3), ("normal", 3))
+
+    def start(self, draws):
+        return uniform(draws[:, :3], -0.1, 0.1), 0.1 * draws[:, 3:]
 
     def prepare(self, actions, q, qd, tau):
         pushes = np.clip(np.asarray(actions, dtype=np.float64).reshape(q.shape[0], 1)[:, 0], -1.0, 1.0)

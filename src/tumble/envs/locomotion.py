@@ -31,7 +31,7 @@ from ..models.build import to_articulation
 from ..models.mjcf import read_mjcf
 from ..rotation import quat_rotate
 from .canvas import Canvas
-from .core import Task
+from .core import Task, uniform
 
 __all__ = [
     "AntTask",
@@ -135,6 +135,8 @@ class LocomotionTask(Task):
         template = self.articulation()
         self._template = template
         self.init_q, self.init_qd = template.q, template.qd
+        nq, nv = self.init_q.shape[0], self.init_qd.shape[0]
+        self.start_draws = (("uniform", nq), ("uniform" if self.uniform_velocity_noise else "normal", nv))
         # each MJCF body is the last link of its chain of joints (models.build.to_articulation)
         self.body_links = np.cumsum([max(1, len(body.joints)) for body in self.description.bodies]) - 1
         self._motors(template)
@@ -169,16 +171,14 @@ class LocomotionTask(Task):
     def _observation_space(self, size: int) -> None:
         self.observation_space = spaces.Box(-np.inf, np.inf, shape=(size,), dtype=np.float64)
 
-    def initial_state(self, rng):
-        noise = self.reset_noise_scale
+    def start(self, draws):
+        noise, nq = self.reset_noise_scale, self.init_q.shape[0]
         # a free joint's quaternion keeps its noise unnormalised, as MuJoCo's qpos does until the first step (the
         # kinematics read it normalised; the step's update normalises it)
-        q = self.init_q + rng.uniform(-noise, noise, size=self.init_q.shape[0])
+        q = self.init_q + uniform(draws[:, :nq], -noise, noise)
         if self.uniform_velocity_noise:
-            qd = self.init_qd + rng.uniform(-noise, noise, size=self.init_qd.shape[0])
-        else:
-            qd = self.init_qd + noise * rng.standard_normal(self.init_qd.shape[0])
-        return q, qd
+            return q, self.init_qd + uniform(draws[:, nq:], -noise, noise)
+        return q, self.init_qd + noise * draws[:, nq:]
 
     def prepare(self, actions, q, qd, tau):
         # the costs square the actions as given (float32 from the action space), as Gymnasium's do

@@ -31,7 +31,7 @@ from .. import portable
 from ..articulation import Articulation, Revolute
 from ..mass import MassProperties
 from .canvas import Canvas
-from .core import Task
+from .core import Task, uniform
 
 __all__ = ["PendulumTask"]
 
@@ -57,9 +57,11 @@ class PendulumTask(Task):
         art.add_link(Revolute((0.0, 1.0, 0.0)), mass_properties=mass, name="rod")
         return art
 
-    def initial_state(self, rng):
-        start = rng.uniform((-math.pi, -1.0), (math.pi, 1.0), size=2)  # (θ, θ̇)
-        return start[:1], start[1:]
+    start_draws = (("uniform", 2),)  # (θ, θ̇)
+
+    def start(self, draws):
+        start = uniform(draws, (-math.pi, -1.0), (math.pi, 1.0))
+        return start[:, :1], start[:, 1:]
 
     def prepare(self, actions, q, qd, tau):
         torques = np.clip(np.asarray(actions, dtype=np.float64).reshape(q.shape[0], 1), -MAX_TORQUE, MAX_TORQUE)

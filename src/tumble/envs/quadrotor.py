@@ -40,7 +40,7 @@ from ..mass import MassProperties
 from ..rotation import quat_from_rotvec, quat_rotate
 from ..vehicles import CRAZYFLIE, Mixer, quadrotor_params, rotor_hubs
 from .canvas import Canvas
-from .core import Task
+from .core import Task, uniform
 
 __all__ = ["QuadrotorHoverTask"]
 
@@ -84,12 +84,11 @@ class QuadrotorHoverTask(Task):
         art.add_link(Free(), mass_properties=body, name="body")
         return art
 
-    def initial_state(self, rng):
-        # position, rotation vector, velocity and body rates, in that order
-        low, high = np.repeat((-0.5, -0.2, -0.5, -0.2), 3), np.repeat((0.5, 0.2, 0.5, 0.2), 3)
-        start = rng.uniform(low, high, size=12)
-        quat = quat_from_rotvec(start[3:6]).reshape(4)
-        return np.concatenate([start[:3], quat]), start[6:]
+    start_draws = (("uniform", 12),)  # position, rotation vector, velocity and body rates, in that order
+
+    def start(self, draws):
+        start = uniform(draws, np.repeat((-0.5, -0.2, -0.5, -0.2), 3), np.repeat((0.5, 0.2, 0.5, 0.2), 3))
+        return np.concatenate([start[:, :3], quat_from_rotvec(start[:, 3:6])], axis=1), start[:, 6:]
 
     def rotor_speeds(self, actions) -> np.ndarray:
         """(copies, 4) [rad/s] of actions in [-1, 1] (clipped)."""
