@@ -100,6 +100,22 @@ def test_compiled_loops_give_the_bits_of_the_python_source():
     assert isinstance(portable.sin(0.5), np.floating) and portable.sin(np.zeros((2, 3))).shape == (2, 3)
 
 
+def test_portable_sin_and_cos_give_the_same_bits_on_their_vectorised_and_their_branching_loops():
+    """An array wholly in SIN_COS_RANGE takes the branch-free loop (``elementary.sin_cos``); one entry beyond it
+    (1e7, inf, NaN) sends the whole array down the branching one. Either way every entry is the scalar's bits."""
+    edges = np.arange(-40, 41) * (math.pi / 4)
+    x = np.concatenate([_log_uniform(-12, 6, 4000), edges, np.nextafter(edges, 0.0), np.nextafter(edges, 10.0),
+                        [0.0, -0.0, 1e-8, -1e-8, elementary.SIN_COS_RANGE, -elementary.SIN_COS_RANGE]])  # fmt: skip
+    x = x[np.abs(x) <= elementary.SIN_COS_RANGE]
+    for array, scalar in ((portable.sin, elementary.sin), (portable.cos, elementary.cos)):
+        near = array(x)
+        assert near.tobytes() == np.array([scalar(float(v)) for v in x]).tobytes(), scalar.__name__
+        for far in (1e7, math.inf, math.nan):
+            mixed = array(np.append(x, far))
+            assert mixed[:-1].tobytes() == near.tobytes()
+            assert np.array(mixed[-1]).tobytes() == np.array(scalar(far)).tobytes(), (scalar.__name__, far)
+
+
 @kernel
 def _sin_cos_loop(x, out):
     """elementary.sin_cos over an array, in a loop LLVM vectorises, beside the branching sin and cos."""

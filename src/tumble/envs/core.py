@@ -156,7 +156,9 @@ class _Copies:
         self.links = np.zeros((n, len(articulation.links), READOUT_WIDTH)) if task.reads_links else None
         self._method = INTEGRATORS[task.integrator]
         self._h = task.dt / task.substeps
-        self._draws, self._draw_count = _draw_plan(task)
+        self._draws, draw_count = _draw_plan(task)
+        self._start_draws = np.zeros((n, draw_count))  # each copy's row: its latest start's draws
+        self._fills: list[tuple] = [()] * n  # each copy's (generator method, its slice of the row) in draw order
 
     @property
     def seeded(self) -> bool:
@@ -171,18 +173,18 @@ class _Copies:
         """Copy ``i`` draws from ``rng`` from now on."""
         self._unseeded -= self.rngs[i] is None
         self.rngs[i] = rng
+        row = self._start_draws[i]
+        self._fills[i] = tuple((getattr(rng, method), row[first:end]) for method, first, end in self._draws)
 
     def reset(self, which: np.ndarray) -> None:
         """Start new episodes in copies ``which`` (int64 indices), each drawn from its own generator; their joint
         forces are zero until the next step, and their links are read at the start if the task reads them."""
-        batch, rngs, plan = self.batch, self.rngs, self._draws
+        batch, fills = self.batch, self._fills
         if len(which):
-            draws = np.empty((len(which), self._draw_count))
-            for row, i in zip(draws, which, strict=True):  # a copy at a time: each draws from its own generator
-                rng = rngs[i]
-                for method, first, end in plan:
-                    getattr(rng, method)(out=row[first:end])
-            batch.q[which], batch.qd[which] = self.task.start(draws)
+            for i in which.tolist():  # a copy at a time: each draws from its own generator
+                for fill, row in fills[i]:
+                    fill(out=row)
+            batch.q[which], batch.qd[which] = self.task.start(self._start_draws[which])
         batch.tau[which] = 0.0
         self.elapsed[which] = 0
         if self.links is not None:
