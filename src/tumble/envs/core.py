@@ -52,9 +52,8 @@ class Task:
     observation_space: gym.Space
     action_space: gym.Space
     # A copy's start as the standard draws it takes from its own generator, in order: ("uniform", n) takes n
-    # uniforms in [0, 1), ("normal", n) n standard normals. Drawn a copy at a time (each copy has its generator),
-    # they are mapped by start() for every restarting copy at once, which costs a copy two short calls, not a
-    # Python method of array arithmetic.
+    # uniforms in [0, 1), ("normal", n) n standard normals. They are drawn a copy at a time (each copy has its own
+    # generator: one short call an entry), and start() maps the draws of every restarting copy at once.
     start_draws: tuple[tuple[str, int], ...] = ()
 
     def articulation(self) -> Articulation:
