@@ -13,7 +13,7 @@ from __future__ import annotations
 from . import actuators, control, mass, rotation, sensors, shapes, vehicles, wind
 from ._version import __version__
 from .batch import Batch
-from .errors import SimulationError
+from .errors import SimulationError, SubstepsRaisedWarning
 from .handles import Body, Joint
 from .joints import BallJoint, DistanceJoint, FixedJoint, HingeJoint, PlanarJoint, SliderJoint, UniversalJoint
 from .mass import MassProperties
@@ -85,6 +85,7 @@ __all__ = [
     "Shape",
     "ShapeType",
     "SimulationError",
+    "SubstepsRaisedWarning",
     "SliderJoint",
     "Sphere",
     "Trajectory",

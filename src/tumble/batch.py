@@ -33,6 +33,7 @@ from .dynamics.actuation import ActuatorArrays
 from .dynamics.integrate import thread_pool, threads
 from .errors import SimulationError
 from .inputs import Inputs
+from .params import substeps_to_run
 from .runner import simulate_steps
 from .scratch import Scratch
 from .state import State
@@ -139,6 +140,7 @@ class Batch:
         world.model  # noqa: B018 (builds the world's model: state and builder agree)
         self._builder = copy.deepcopy(world._builder)
         self._params = copy.deepcopy(world._params)
+        self._substeps_told: set = set()  # the (asked, raised) substeps a warning told (params.substeps_to_run)
         self._base = self._builder.finalize(world.gravity)
         self._n = n
         base = self._base
@@ -381,7 +383,7 @@ class Batch:
         steps = as_count("steps", steps)
         free = not self._base.has_constraints
         if not free:
-            self._params.solver.substeps_for(dt)
+            substeps_to_run(self._params.solver, dt, self._substeps_told, "Batch")
         if self._stale:
             for block in self._blocks:
                 block.model = rows_model(self._base, self._tables(block.first, block.last), fold_gravity=free)

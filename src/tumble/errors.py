@@ -2,7 +2,13 @@
 
 from __future__ import annotations
 
-__all__ = ["SimulationError"]
+import os
+import sys
+import warnings
+
+__all__ = ["SimulationError", "SubstepsRaisedWarning", "warn_user"]
+
+_PACKAGE = os.path.dirname(os.path.abspath(__file__))
 
 
 class SimulationError(RuntimeError):
@@ -23,3 +29,15 @@ class SimulationError(RuntimeError):
         self.body = body
         self.step = step
         self.controller = controller
+
+
+class SubstepsRaisedWarning(UserWarning):
+    """A step runs more substeps than the world was asked for: its contacts need them (``World.substeps``)."""
+
+
+def warn_user(message: str, category: type[Warning]) -> None:
+    """Warn at the user's line: the first caller outside the tumble package (however deep the call came)."""
+    frame, level = sys._getframe(1), 2
+    while frame is not None and frame.f_code.co_filename.startswith(_PACKAGE):
+        frame, level = frame.f_back, level + 1
+    warnings.warn(message, category, stacklevel=level)

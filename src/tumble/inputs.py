@@ -26,6 +26,11 @@ class Inputs:
     def zeros(cls, body_count: int) -> Inputs:
         return cls(np.zeros((body_count, 3)), np.zeros((body_count, 3)))
 
+    def grown(self, added: int) -> Inputs:
+        """These loads with ``added`` zero rows after them (for bodies added since)."""
+        zeros = np.zeros((added, 3))
+        return Inputs(np.concatenate([self.body_force, zeros]), np.concatenate([self.body_torque, zeros]))
+
     def clear(self) -> None:
         self.body_force.fill(0.0)
         self.body_torque.fill(0.0)

@@ -9,9 +9,18 @@ from enum import IntEnum
 import numpy as np
 
 from ._validate import MAX_COUNT, as_float
-from .dynamics.contact_solver import SolverSettings
+from .dynamics.contact_solver import SUBSTEP_RATE_PER_CONTACT_HERTZ, SolverSettings
+from .errors import SubstepsRaisedWarning, warn_user
 
-__all__ = ["Integrator", "Params", "INTEGRATOR_NAMES", "DEFAULT_SOLVER", "SolverSettings", "solver_with"]
+__all__ = [
+    "Integrator",
+    "Params",
+    "INTEGRATOR_NAMES",
+    "DEFAULT_SOLVER",
+    "SolverSettings",
+    "solver_with",
+    "substeps_to_run",
+]
 
 
 class Integrator(IntEnum):
@@ -105,3 +114,21 @@ def solver_with(solver: SolverSettings, settings: dict) -> SolverSettings:
             positive = key in ("contact_hertz", "contact_push_max", "joint_hertz")
             current[key] = as_float(key, value, positive=positive, nonnegative=not positive)
     return SolverSettings(**current)
+
+
+def substeps_to_run(solver: SolverSettings, dt: float, warned: set, owner: str = "World") -> int:
+    """The substeps a step of ``dt`` runs (``solver.substeps_for(dt)``). Where that is more than ``solver.substeps``,
+    a :class:`~tumble.errors.SubstepsRaisedWarning` says so and why, once for each asked and raised number (``warned``
+    keeps the pairs already told)."""
+    used = solver.substeps_for(dt)
+    if used > solver.substeps and (solver.substeps, used) not in warned:
+        warned.add((solver.substeps, used))
+        longest = 1.0 / (SUBSTEP_RATE_PER_CONTACT_HERTZ * solver.contact_hertz)
+        warn_user(
+            f"{owner}(substeps={solver.substeps}) runs {used} substeps at dt={dt:g}: contacts of "
+            f"contact_hertz={solver.contact_hertz:g} need {SUBSTEP_RATE_PER_CONTACT_HERTZ:g} substeps per contact "
+            f"period, or stacks sag and topple (a substep of at most {longest:.3g} s). "
+            "A smaller dt or contact_hertz runs fewer.",
+            SubstepsRaisedWarning,
+        )
+    return used

@@ -110,6 +110,7 @@ class World:
         self._wind: Wind | None = None
         self._attachments: list = []  # what attach() registered: vehicles (tumble.vehicles.Quadrotor)
         self._joint_drives = None  # tumble.joint_drives.JointDrives, made with the first joint actuator
+        self._last_dt, self._substeps_told = None, set()  # the last step's dt; the (asked, raised) substeps told
 
     @classmethod
     def _from_builder(cls, builder: ModelBuilder, state: State, inputs: Inputs, *, gravity, params: Params) -> World:
@@ -397,11 +398,7 @@ class World:
         the model is left as it is."""
         if self._pending[0]:
             self._state = self._state.grown(*(np.array(column) for column in self._pending))
-            added = Inputs.zeros(len(self._pending[0]))
-            self._inputs = Inputs(
-                np.concatenate([self._inputs.body_force, added.body_force]),
-                np.concatenate([self._inputs.body_torque, added.body_torque]),
-            )
+            self._inputs = self._inputs.grown(len(self._pending[0]))
             for column in self._pending:
                 column.clear()
         self._state.with_joints(len(self._builder.joints))
@@ -460,9 +457,15 @@ class World:
         """The contact solver's settings (read-only; change them with :meth:`set_solver`)."""
         return self._params.solver
 
+    @property
+    def substeps(self) -> int:
+        """The substeps a step runs: those asked, or more where the last step's ``dt`` is too long for contacts of
+        ``contact_hertz`` (a ``tumble.SubstepsRaisedWarning`` said so, once; ``docs/contact.md``)."""
+        return world_stepping.substeps_run(self)
+
     def set_solver(self, **settings) -> None:
         """Change contact solver settings by name: ``substeps`` (int >= 1; a step takes more where contacts of
-        ``contact_hertz`` need them, 8 per contact period, see ``solver.substeps_for(dt)``), ``contact_hertz`` (> 0),
+        ``contact_hertz`` need them, 8 per contact period, saying so once: ``World.substeps``), ``contact_hertz`` (> 0),
         ``contact_damping_ratio`` (>= 0), ``contact_push_max`` [m/s] (> 0; joint limits push a joint outside its range
         back at most this fast too, in rad/s for angles), ``restitution_threshold`` [m/s] (>= 0),
         ``speculative_distance`` [m] (>= 0), ``sleep`` (bool), ``sleep_linear`` [m/s], ``sleep_angular`` [rad/s],

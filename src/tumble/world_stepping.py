@@ -12,11 +12,12 @@ import numpy as np
 
 from ._validate import as_count, as_float, as_step, step_count
 from .errors import SimulationError
+from .params import substeps_to_run
 from .runner import ReadyStep, simulate_steps, step_by_step
 from .trajectory import Trajectory
 from .wind import Constant
 
-__all__ = ["checked_step", "simulate", "step"]
+__all__ = ["checked_step", "note_substeps", "simulate", "step", "substeps_run"]
 
 
 def step(world, dt: float) -> None:
@@ -29,7 +30,10 @@ def step(world, dt: float) -> None:
     ready = world._scratch.ready
     if ready is not None and ready.fits(world._model, world._state, world._inputs, world._params,
                                         world._actuation._arrays):  # fmt: skip
-        failing = ready(as_step("dt", dt, world._state.time))
+        dt = as_step("dt", dt, world._state.time)
+        if dt != world._last_dt:
+            note_substeps(world, dt)
+        failing = ready(dt)
     else:
         dt = checked_step(world, dt)
         failing = _controlled_step(world, dt)
@@ -45,9 +49,25 @@ def checked_step(world, dt) -> float:
     needs no more substeps than it allows (before any controller runs or state changes)."""
     dt = as_step("dt", dt, world._state.time)
     world._sync()
-    if world._model.has_constraints:
-        world._params.solver.substeps_for(dt)
+    note_substeps(world, dt)
     return dt
+
+
+def substeps_run(world) -> int:
+    """``World.substeps``: what the last step's ``dt`` runs with the solver's settings now; before the first step, and
+    in a world whose bodies neither touch nor are jointed (they take no substeps), the number asked."""
+    solver = world._params.solver
+    if world._last_dt is None or world._model is None or not world._model.has_constraints:
+        return solver.substeps
+    return solver.substeps_for(world._last_dt)
+
+
+def note_substeps(world, dt: float) -> None:
+    """Keep ``dt`` as the world's last step (``World.substeps``); where the contact solver runs, check its substeps
+    and warn, once, if it must raise them."""
+    if world._model.has_constraints:
+        substeps_to_run(world._params.solver, dt, world._substeps_told)
+    world._last_dt = dt
 
 
 def _controlled_step(world, dt: float, stage=None) -> int:

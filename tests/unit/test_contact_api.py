@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 import pytest
 
@@ -96,6 +98,40 @@ def test_a_step_takes_at_least_eight_substeps_per_contact_period(substeps, hertz
     """Static contacts at 2 contact_hertz hold up to a quarter of the substep rate: the rate is 8 contact_hertz at
     least (1/60 s times 480 Hz is 8.000000000000002 in floating point, and still 8 substeps)."""
     assert tumble.World(substeps=substeps, contact_hertz=hertz).solver.substeps_for(dt) == taken
+
+
+def test_a_world_says_the_substeps_it_runs_and_warns_once_where_it_raises_them():
+    """``World(substeps=n)`` runs n substeps; where contacts need more, ``world.substeps`` says what runs and a
+    warning names the numbers and why, once for each, at the user's line (API.md, "Substeps")."""
+    world, _, _ = resting_box()
+    world.set_solver(substeps=4)
+    assert world.substeps == 4  # before a step: what was asked
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        world.step(1 / 60)
+        world.step(1 / 60)  # the fast path of an unchanged world
+        world.simulate(0.1, 1 / 60)
+        assert world.substeps == 8
+        world.step(1 / 30)
+        assert world.substeps == 16
+        world.step(1 / 30)
+        world.step(1 / 240)
+        assert world.substeps == 4
+    told = [w for w in caught if issubclass(w.category, tumble.SubstepsRaisedWarning)]
+    assert [str(w.message).split(":")[0] for w in told] == [
+        "World(substeps=4) runs 8 substeps at dt=0.0166667",
+        "World(substeps=4) runs 16 substeps at dt=0.0333333",
+    ]
+    assert "contact_hertz=60" in str(told[0].message) and all(w.filename == __file__ for w in told)
+    world.set_solver(contact_hertz=15.0)  # softer contacts take a 30 Hz step in 4 substeps
+    assert world.substeps == 4
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        world.step(1 / 30)
+        batch = tumble.Batch(world, 2)
+        batch.step(1 / 30)
+    with pytest.warns(tumble.SubstepsRaisedWarning, match=r"Batch\(substeps=4\) runs 8 substeps"):
+        batch.step(1 / 15)
 
 
 @pytest.mark.parametrize("dt", [0.0, -0.01, float("nan"), "fast"])
