@@ -78,22 +78,65 @@ def test_a_box_dropped_flat_rebounds_to_e_squared_h_without_spinning(restitution
         assert spin < 1e-6  # measured 4e-11 rad/s
 
 
+def dropped_shape(name: str) -> tumble.Shape:
+    """The bodies of the energy grid: a 0.3 x 0.2 x 0.1 m box, a cylinder (r 0.1 m, 0.3 m long), an irregular hull."""
+    if name == "box":
+        return tumble.Box((0.3, 0.2, 0.1))
+    if name == "cylinder":
+        return tumble.Cylinder(0.1, 0.3)
+    return tumble.ConvexHull(np.random.default_rng(3).normal(size=(12, 3)) * (0.15, 0.1, 0.07))
+
+
+def energy_rise(name: str, angle: float, restitution: float, rate: int, substeps: int) -> float:
+    """The most a body's total energy rises above its start, over its start, while it falls 1.2 m tilted by
+    ``angle`` degrees onto a plane (both with ``restitution``, friction 0.5) and tumbles for 2 s, sampled every step.
+
+    The energy is semi-implicit Euler's own: its velocity leads its positions by half a substep ``h``, so it is taken
+    at the time of the positions, ``v + g h/2`` (free flight then keeps it exactly; the plain ``½ m v² + m g z``
+    rises by ``m g u h`` at any bounce at ``u``, a perfect one included)."""
+    world = tumble.World(substeps=substeps)
+    world.add_static(tumble.Plane(), restitution=restitution)
+    body = world.add_body(dropped_shape(name), density=1000.0, position=(0, 0, 1.2), restitution=restitution,
+                          orientation=quat_from_axis_angle((1, 2, 0.5), np.radians(angle)))  # fmt: skip
+    h = 1 / rate / world.solver.substeps_for(1 / rate)
+    g = world.gravity
+
+    def energy() -> float:
+        return (
+            world.total_energy() + body.mass * float(body.velocity @ g) * h / 2 + body.mass * float(g @ g) * h * h / 8
+        )
+
+    start, rise = energy(), -np.inf
+    for _ in range(int(2 * rate)):
+        world.step(1 / rate)
+        rise = max(rise, energy() - start)
+    return rise / start
+
+
+# The most an elastic bounce (e = 1) may still gain (issue 50, open): measured 2.5e-5 to 3.4e-2 (box at 5°, 1000 Hz, 1
+# substep) in 20 of the grid's 60 cells and shapes, within 1e-6 in the others. A spinning body's point that curves
+# into the ground within a substep bounces with its orientation moved back by τ Δω while ω is held in the world frame.
+ELASTIC_GAIN = 0.04
+
+
 @pytest.mark.parametrize(("rate", "substeps"), GRID)
-def test_a_tumbling_box_with_restitution_never_gains_energy(rate, substeps):
-    """A 0.3 x 0.2 x 0.1 m box dropped at a slant (5°, 20°, 40°) with e = 0.5 lands on corners and edges, its points
-    touching at different times within a substep and bouncing one after the other: the total energy, sampled
-    every 0.05 s for 2 s, never rises above its start (measured: at most −1.3e-5 of it, at 1000 Hz with 16
-    substeps, the semi-implicit free fall's own loss). With e = 1 it can (up to +15 % over 2 s at 60 Hz, 8
-    substeps; +70 % before issue 16): Newton's law at several points bounced in turn is not energy-safe."""
-    for angle in (5.0, 20.0, 40.0):
-        world = tumble.World(substeps=substeps)
-        world.add_static(tumble.Plane(), restitution=0.5)
-        world.add_body(tumble.Box((0.3, 0.2, 0.1)), density=1000.0, position=(0, 0, 1.2), restitution=0.5,
-                       orientation=quat_from_axis_angle((1, 2, 0.5), np.radians(angle)))  # fmt: skip
-        start = world.total_energy()
-        for _ in range(40):
-            world.simulate(0.05, 1 / rate)
-            assert world.total_energy() <= start
+@pytest.mark.parametrize("name", ["box", "cylinder", "hull"])
+def test_a_tumbling_body_never_gains_energy_from_its_bounces(name, rate, substeps):
+    """A box, a cylinder and a hull dropped at a slant (5°, 20°, 40°) land on corners and edges, their points touching
+    at different times within a substep: with e = 0.5 and 0.9 the energy never rises above its start by more than
+    1e-6 of it (measured at most 1.3e-13). With e = 1 it rose by up to 38 % (box, 60 Hz) before issue 50: impulses
+    turned ω through the inertia of the step's start, and a box at 50 rad/s turns 0.8 rad in a step; a bounce on a
+    point the step's rotation brought in was stopped and then bounced from stale speeds. Now at most
+    ``ELASTIC_GAIN``, and within 1e-6 in most cells (the strict xfail below is the open part)."""
+    for restitution in (0.5, 0.9, 1.0):
+        for angle in (5.0, 20.0, 40.0):
+            bound = ELASTIC_GAIN if restitution == 1.0 else 1e-6
+            assert energy_rise(name, angle, restitution, rate, substeps) <= bound, (restitution, angle)
+
+
+@pytest.mark.xfail(strict=True, reason="issue 50, open: an elastic bounce of a fast-spinning hull gains 9.6e-3")
+def test_an_elastic_bounce_of_a_spinning_hull_never_gains_energy():
+    assert energy_rise("hull", 40.0, 1.0, 60, 4) <= 1e-6
 
 
 def cradle(offset: float, rate: int, substeps: int) -> tuple[float, float, float]:

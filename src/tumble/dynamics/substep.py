@@ -38,15 +38,21 @@ def to_angular_velocity(bodies, quat, angmom, angvel, inv_inertia_world):
     Writes: angvel (n, 3), inv_inertia_world (n, 3, 3).
     """
     for i in range(quat.shape[0]):
-        q = load4(quat, i)
-        inv_i = load33(bodies.inv_inertia_local, i)
-        store3(angvel, i, world_inertia_apply(q, inv_i, load3(angmom, i)))
-        for c in range(3):
-            e = (1.0 if c == 0 else 0.0, 1.0 if c == 1 else 0.0, 1.0 if c == 2 else 0.0)
-            column = world_inertia_apply(q, inv_i, e)
-            inv_inertia_world[i, 0, c] = column[0]
-            inv_inertia_world[i, 1, c] = column[1]
-            inv_inertia_world[i, 2, c] = column[2]
+        store3(angvel, i, world_inertia_apply(load4(quat, i), load33(bodies.inv_inertia_local, i), load3(angmom, i)))
+        _store_world_inverse_inertia(bodies, quat, i, inv_inertia_world)
+
+
+@inline
+def _store_world_inverse_inertia(bodies, quat, i, inv_inertia_world):
+    """Body ``i``'s ``R I⁻¹ Rᵀ`` at its orientation now, column by column."""
+    q = load4(quat, i)
+    inv_i = load33(bodies.inv_inertia_local, i)
+    for c in range(3):
+        e = (1.0 if c == 0 else 0.0, 1.0 if c == 1 else 0.0, 1.0 if c == 2 else 0.0)
+        column = world_inertia_apply(q, inv_i, e)
+        inv_inertia_world[i, 0, c] = column[0]
+        inv_inertia_world[i, 1, c] = column[1]
+        inv_inertia_world[i, 2, c] = column[2]
 
 
 @inline(counted=False)
@@ -81,12 +87,16 @@ def integrate_velocities(bodies, moving, gravity, force, torque, acts, tau, quat
 
 
 @inline(counted=False)
-def integrate_positions(moving, linvel, angvel, pos, quat, h):
-    """``x += h v``, ``q ← q + h ½ (0, ω) ⊗ q`` renormalised; moving (awake dynamic) bodies."""
+def integrate_positions(bodies, moving, linvel, angvel, pos, quat, inv_inertia_world, h):
+    """``x += h v``, ``q ← q + h ½ (0, ω) ⊗ q`` renormalised, and ``R I⁻¹ Rᵀ`` at the new orientation; moving (awake
+    dynamic) bodies. The impulses of the rest of the step turn ω through the inertia of the body as it lies now: a
+    box spinning at 50 rad/s turns 0.8 rad in a 60 Hz step, and an impulse through the inertia of its start gave a
+    bounce with e = 1 up to 26 % more energy than it had (issue 50)."""
     for i in range(pos.shape[0]):
         if moving[i]:
             store3(pos, i, add_scaled(load3(pos, i), load3(linvel, i), h))
             store4(quat, i, quat_integrate(load4(quat, i), load3(angvel, i), h))
+            _store_world_inverse_inertia(bodies, quat, i, inv_inertia_world)
 
 
 @inline
@@ -118,7 +128,7 @@ def run_substeps(
                          joint_moment_total)  # fmt: skip
         solve_contacts(rows, count, inv_mass, inv_inertia_world, pos, quat, pos0, quat0, linvel, angvel, inv_h,
                        push_max, True, threshold)  # fmt: skip
-        integrate_positions(moving, linvel, angvel, pos, quat, h)
+        integrate_positions(bodies, moving, linvel, angvel, pos, quat, inv_inertia_world, h)
         if jointed:
             solve_joints(joints, joint_impulses, inv_mass, inv_inertia_world, pos, quat, linvel, angvel, h,
                          joint_hertz, joint_damping_ratio, push_max, False, joint_force_total,
