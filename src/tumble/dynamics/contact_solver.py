@@ -483,8 +483,10 @@ def solve_contacts(
             elif use_bias:
                 bias, m_scale, i_scale = max(bias_rate * s, -push_max), mass_scale, impulse_scale
             if use_bias and rows.max_normal_impulse[m, j] == 0.0:
-                # Not pushed yet this step: the approach speed at the substep of impact is what bounces.
-                rows.relative_velocity[m, j] = min(rows.relative_velocity[m, j], vn)
+                # Not pushed yet this step: the approach speed at the substep of impact is what bounces, not the
+                # speed at the step's start (another point's bounce may have slowed it since: an elastic box then
+                # gained 3.4 % of its energy, issue 50).
+                rows.relative_velocity[m, j] = vn
             old = rows.normal_impulse[m, j]
             new = max(old - rows.normal_mass[m, j] * m_scale * (vn + bias) - i_scale * old, 0.0)
             rows.normal_impulse[m, j] = new
