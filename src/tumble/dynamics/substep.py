@@ -18,6 +18,7 @@ from ..math3d import (
     quat_integrate,
     quat_rotate,
     quat_rotate_inv,
+    quat_to_mat33,
     scale,
     store3,
     store4,
@@ -44,15 +45,18 @@ def to_angular_velocity(bodies, quat, angmom, angvel, inv_inertia_world):
 
 @inline
 def _store_world_inverse_inertia(bodies, quat, i, inv_inertia_world):
-    """Body ``i``'s ``R I⁻¹ Rᵀ`` at its orientation now, column by column."""
-    q = load4(quat, i)
-    inv_i = load33(bodies.inv_inertia_local, i)
-    for c in range(3):
-        e = (1.0 if c == 0 else 0.0, 1.0 if c == 1 else 0.0, 1.0 if c == 2 else 0.0)
-        column = world_inertia_apply(q, inv_i, e)
-        inv_inertia_world[i, 0, c] = column[0]
-        inv_inertia_world[i, 1, c] = column[1]
-        inv_inertia_world[i, 2, c] = column[2]
+    """Body ``i``'s ``R I⁻¹ Rᵀ`` at its orientation now (``I⁻¹`` symmetric: the upper triangle, mirrored)."""
+    r = quat_to_mat33(load4(quat, i))
+    a = load33(bodies.inv_inertia_local, i)
+    for row in range(3):
+        # Row ``row`` of R A, then its products with the rows of R (the columns of Rᵀ) from the diagonal on.
+        x = r[3 * row] * a[0] + r[3 * row + 1] * a[3] + r[3 * row + 2] * a[6]
+        y = r[3 * row] * a[1] + r[3 * row + 1] * a[4] + r[3 * row + 2] * a[7]
+        z = r[3 * row] * a[2] + r[3 * row + 1] * a[5] + r[3 * row + 2] * a[8]
+        for column in range(row, 3):
+            value = x * r[3 * column] + y * r[3 * column + 1] + z * r[3 * column + 2]
+            inv_inertia_world[i, row, column] = value
+            inv_inertia_world[i, column, row] = value
 
 
 @inline(counted=False)
