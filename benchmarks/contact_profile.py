@@ -135,7 +135,7 @@ class _Replay:
                 self.timed("solve_joints", *joint_args, h, joint_hertz, joint_damping, push_max, True, joint_force,
                            joint_moment)  # fmt: skip
             self.timed("solve_contacts", rows, count, *body_args, 1.0 / h, push_max, True, threshold)
-            self.timed("integrate_positions", moving, linvel, angvel, pos, quat, h)
+            self.timed("integrate_positions", bodies, moving, linvel, angvel, pos, quat, inv_inertia, h)
             if jointed:
                 self.timed("relax_joints", *joint_args, h, joint_hertz, joint_damping, push_max, False, joint_force,
                            joint_moment)  # fmt: skip

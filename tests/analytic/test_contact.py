@@ -199,14 +199,14 @@ def test_contact_runs_are_bit_identical():
     assert a.state.digest() == b.state.digest()
 
 
-def _crosses_wall(shape, speed, wall_angle_deg, spin) -> bool:
+def _crosses_wall(shape, speed, wall_angle_deg, spin, rate: int = 60) -> bool:
     """Whether a spinning body fired at a slanted 2 cm static wall ever passes from its near side to its far side
-    between two frames (within the wall's extent)."""
+    between two frames of ``1 / rate`` s (within the wall's extent)."""
     world = tumble.World(gravity=(0, 0, 0))
     turn = quat_from_axis_angle((0, 0, 1), np.radians(wall_angle_deg))
     world.add_static(tumble.Box((0.02, 2.0, 2.0)), position=(1.0, 0, 0), orientation=turn)
     body = world.add_body(shape, density=1000.0, velocity=(speed, 0, 0), angular_velocity=spin)
-    traj = world.simulate(0.3, DT)
+    traj = world.simulate(0.3, 1 / rate)
     rotation = quat_to_matrix(turn)
     relative = traj.position[:, body.index] - (1.0, 0.0, 0.0)
     depth, across = relative @ rotation[:, 0], relative @ rotation[:, 1]
@@ -227,13 +227,19 @@ SPINNING = {
 def test_spinning_bodies_at_30_m_per_s_do_not_tunnel_through_a_slanted_wall(name, wall_angle_deg):
     # Speculative contacts alone let the cylinder through at every angle, and the others at 100 m/s: the time of
     # impact sweep (geometry/toi.py) stops them.
-    if name == "cylinder" and wall_angle_deg == 30.0:
-        pytest.xfail(
-            "issue 3, open: spun up to 180 rad/s by the first impact, the cylinder works its way through the "
-            "wall over several steps while the contact cannot hold it (its core is in the wall by then)"
-        )
     shape, spin = SPINNING[name]
     assert not _crosses_wall(shape, 30.0, wall_angle_deg, spin)
+
+
+@pytest.mark.parametrize("rate", [60, 240, 1000])
+def test_a_cylinder_its_impact_spins_to_300_rad_per_s_is_held_by_the_wall_at_every_rate(rate):
+    """The cylinder above, spun to 110-320 rad/s by its first impact (3-5 rad in a 60 Hz step), stays on the wall's
+    near side at 60, 240 and 1000 Hz (issue 50, part 3). Its 30° case was an imperative xfail (issue 3: it worked its
+    way through over several steps) that never ran its check: it already held before issue 50's changes, and
+    still does after them (measured at both)."""
+    shape, spin = SPINNING["cylinder"]
+    for wall_angle_deg in (0.0, 30.0, 60.0):
+        assert not _crosses_wall(shape, 30.0, wall_angle_deg, spin, rate), wall_angle_deg
 
 
 @pytest.mark.parametrize("name", ["box", "capsule", "hull"])
