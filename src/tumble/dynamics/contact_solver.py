@@ -8,8 +8,8 @@ sequential impulses with a *soft* position bias (a spring of ``contact_hertz`` a
 ``softness.py``), the positions are integrated, and a relax pass solves the constraints again without bias
 so that the push-out does not leave velocity behind. Impacts with restitution bounce in the substep where they
 touch, at the time of touch, with the approach speed at the surface (:func:`resolve_impacts`); after the substeps,
-restitution is applied once more, from the velocities recorded before the step, to the points that pushed without
-having bounced (:func:`apply_restitution`). Contacts with positive separation are speculative:
+restitution is applied once more, from each point's approach speed at the substep it first pushed, to the points
+that pushed without having bounced (:func:`apply_restitution`). Contacts with positive separation are speculative:
 they only stop the bodies from closing the gap faster than ``separation / h``, which keeps fast bodies
 from tunnelling through each other.
 
@@ -127,7 +127,7 @@ class ContactRows(NamedTuple):
     normal_impulse: np.ndarray  # (M, 4) accumulated λn of the current substep [N s]
     tangent_impulse: np.ndarray  # (M, 4, 2) accumulated friction impulse along tangent1, tangent2
     max_normal_impulse: np.ndarray  # (M, 4) largest incremental λn of the step (did the point push?)
-    relative_velocity: np.ndarray  # (M, 4) normal relative velocity before the step [m/s]
+    relative_velocity: np.ndarray  # (M, 4) normal approach velocity: before the step, then at the first push [m/s]
     softness: np.ndarray  # (M, 3) bias_rate, mass_scale, impulse_scale
     total_normal_impulse: np.ndarray  # (M, 4) λn summed over the substeps and restitution: the step's impulse
     total_tangent_impulse: np.ndarray  # (M, 4, 2) friction impulse summed over the step
@@ -453,10 +453,11 @@ def solve_contacts(
 ):  # fmt: skip
     """One Gauss–Seidel pass over all contacts: normal impulses (soft when ``use_bias``), then friction.
 
-    A point that will bounce (restitution, closing faster than ``threshold``) is not held to the speculative
-    ``vn ≥ −s/h`` by the relax pass while it is still apart: :func:`resolve_impacts` bounces it in the substep of
-    the touch with the speed it has there. Slowed to close the gap in one more substep, it kept only
-    ``((s/h + g h) / v)²`` of its rebound energy, anywhere from 0 to 1 with where the touch fell in the substep.
+    A point that will bounce (restitution, closing faster than ``threshold``) is left alone by the relax pass:
+    :func:`resolve_impacts` bounces it in the substep of the touch (or the next, if the substep's rotation brought
+    it in) with the speed it has there. Slowed to close the gap in one more substep, it kept only
+    ``((s/h + g h) / v)²`` of its rebound energy, anywhere from 0 to 1 with where the touch fell in the substep;
+    stopped once in, it bounced at the step's end from a stale speed and could gain energy (issue 50).
 
     Reads: rows, body poses now (``pos``, ``quat``) and at the start of the step (``pos0``, ``quat0``).
     Writes: rows.normal_impulse, rows.tangent_impulse, rows.max_normal_impulse, linvel, angvel.
