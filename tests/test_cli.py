@@ -365,7 +365,8 @@ def test_main_in_process_and_bench_outside_a_checkout(monkeypatch, capsys):
 
 def test_a_ctrl_c_that_python_drops_is_raised_again_at_the_next_chunk():
     """Python drops a KeyboardInterrupt raised inside a weakref callback or __del__ ("Exception ignored in ..."):
-    a run went on for its whole duration when Ctrl-C landed in one. The latch raises it after the chunk."""
+    a run went on for its whole duration when Ctrl-C landed in one; inside Numba's ``_numba_unpickle`` it ended the
+    run with a SystemError and status 1. The latch raises it after the chunk."""
     from tumble.cli import _InterruptLatch
 
     with _InterruptLatch() as latch:
@@ -383,6 +384,21 @@ def test_a_ctrl_c_that_python_drops_is_raised_again_at_the_next_chunk():
         Finalised()
         with pytest.raises(KeyboardInterrupt):
             latch.check()
+    with _InterruptLatch() as latch:
+
+        def _numba_unpickle():  # Numba's, called from compiled code: raised there, it ends the run as a SystemError
+            def rebuild():
+                latch._handle(signal.SIGTERM, sys._getframe())  # latched, not raised
+
+            rebuild()
+
+        try:
+            _numba_unpickle()
+        except KeyboardInterrupt:  # (not left to escape: pytest would stop the whole session)
+            pytest.fail("the latch raised inside _numba_unpickle")
+        with pytest.raises(KeyboardInterrupt) as caught:
+            latch.check()
+        assert type(caught.value).__name__ == "_Terminated"
     with _InterruptLatch() as latch:
         with pytest.raises(KeyboardInterrupt) as caught:
             latch._handle(signal.SIGTERM, sys._getframe())
