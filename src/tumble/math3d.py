@@ -54,6 +54,13 @@ def load33(array, i):
 
 
 @inline
+def store33(array, i, m):
+    """Write the row-major 9-tuple ``m`` into the ``i``-th 3x3 matrix of an ``(n, 3, 3)`` array."""
+    for k in range(9):
+        array[i, k // 3, k % 3] = m[k]
+
+
+@inline
 def add(a, b):
     return (a[0] + b[0], a[1] + b[1], a[2] + b[2])
 
@@ -231,6 +238,32 @@ def quat_to_mat33(q):
         2.0 * (x * y + w * z), 1.0 - 2.0 * (x * x + z * z), 2.0 * (y * z - w * x),
         2.0 * (x * z - w * y), 2.0 * (y * z + w * x), 1.0 - 2.0 * (x * x + y * y),
     )  # fmt: skip
+
+
+@inline
+def turned_symmetric33(q, a):
+    """``R A Rᵀ`` for the rotation ``R`` of the unit quaternion ``q`` and a symmetric ``A`` (a row-major 9-tuple): an
+    inertia, or its inverse, carried from one frame to another. The upper triangle, mirrored (about 90 flops); an
+    isotropic ``A`` (a sphere's, a cube's) is its own turn, and is returned as it is, without ``R``."""
+    if a[1] == 0.0 and a[2] == 0.0 and a[5] == 0.0 and a[0] == a[4] and a[0] == a[8]:
+        return a
+    r = quat_to_mat33(q)
+    # The rows of R A, then their products with the rows of R (the columns of Rᵀ) from the diagonal on.
+    x0 = r[0] * a[0] + r[1] * a[3] + r[2] * a[6]
+    y0 = r[0] * a[1] + r[1] * a[4] + r[2] * a[7]
+    z0 = r[0] * a[2] + r[1] * a[5] + r[2] * a[8]
+    x1 = r[3] * a[0] + r[4] * a[3] + r[5] * a[6]
+    y1 = r[3] * a[1] + r[4] * a[4] + r[5] * a[7]
+    z1 = r[3] * a[2] + r[4] * a[5] + r[5] * a[8]
+    x2 = r[6] * a[0] + r[7] * a[3] + r[8] * a[6]
+    y2 = r[6] * a[1] + r[7] * a[4] + r[8] * a[7]
+    z2 = r[6] * a[2] + r[7] * a[5] + r[8] * a[8]
+    m01 = x0 * r[3] + y0 * r[4] + z0 * r[5]
+    m02 = x0 * r[6] + y0 * r[7] + z0 * r[8]
+    m12 = x1 * r[6] + y1 * r[7] + z1 * r[8]
+    return (x0 * r[0] + y0 * r[1] + z0 * r[2], m01, m02,
+            m01, x1 * r[3] + y1 * r[4] + z1 * r[5], m12,
+            m02, m12, x2 * r[6] + y2 * r[7] + z2 * r[8])  # fmt: skip
 
 
 @inline

@@ -128,6 +128,47 @@ def test_a_tumbling_body_never_gains_energy_from_its_bounces(name, rate, substep
             assert energy_rise(name, angle, restitution, rate, substeps) <= 1e-6, (restitution, angle)
 
 
+def elastic_pile_rise(seed: int, rate: int, substeps: int) -> float:
+    """The largest rise of the total energy in one step, over its start, while six boxes and hulls (random sizes,
+    tilts and spins of ~5 rad/s, from ``seed``) fall onto each other and a plane with e = 1 (friction 0.5) for 2 s;
+    the energy taken at the positions' time, as in :func:`energy_rise`."""
+    rng = np.random.default_rng(seed)
+    world = tumble.World(substeps=substeps)
+    world.add_static(tumble.Plane(), restitution=1.0)
+    bodies = []
+    for i in range(6):
+        shape = (
+            tumble.Box(tuple(rng.uniform(0.1, 0.3, 3))) if i % 2 else tumble.ConvexHull(rng.normal(size=(12, 3)) * 0.1)
+        )
+        position = (rng.uniform(-0.15, 0.15), rng.uniform(-0.15, 0.15), 0.5 + 0.4 * i)
+        orientation = quat_from_axis_angle(rng.normal(size=3), rng.uniform(0, 3))
+        bodies.append(world.add_body(shape, density=1000.0, restitution=1.0, position=position, orientation=orientation,
+                                     angular_velocity=rng.normal(size=3) * 5))  # fmt: skip
+    h = 1 / rate / world.solver.substeps_for(1 / rate)
+    g = world.gravity
+
+    def energy() -> float:
+        lead = sum(b.mass * (float(b.velocity @ g) * h / 2 + float(g @ g) * h * h / 8) for b in bodies)
+        return world.total_energy() + lead
+
+    start = previous = energy()
+    rise = -np.inf
+    for _ in range(int(2 * rate)):
+        world.step(1 / rate)
+        now = energy()
+        rise, previous = max(rise, now - previous), now
+    return rise / start
+
+
+@pytest.mark.parametrize(("rate", "substeps"), [(60, 8), (240, 4), (1000, 1)])
+def test_a_pile_of_spinning_bodies_bouncing_elastically_never_gains_energy_in_a_step(rate, substeps):
+    """Bodies that strike each other, not only the ground, spinning: both bodies of a pair are turned to the touch.
+    Over four seeds no step adds more than 1e-6 of the energy (measured: none adds any, every step loses 2e-8 to
+    4e-6). Before the bounce turned ω through the inertia of the touch (950304f), steps added 1e-4 to 4.7e-3."""
+    for seed in range(4):
+        assert elastic_pile_rise(seed, rate, substeps) <= 1e-6, seed
+
+
 def cradle(offset: float, rate: int, substeps: int) -> tuple[float, float, float]:
     """Newton's cradle (``scenes.newtons_cradle``, striker at 2 m/s) with the striker ``offset`` further back, after
     1 s: the last ball's speed over the striker's, the kinetic energy over its start, and the striker's speed."""

@@ -42,10 +42,11 @@ from ..math3d import (
     quat_mul,
     quat_normalize,
     quat_rotate,
-    quat_to_mat33,
     scale,
     store3,
+    store33,
     sub,
+    turned_symmetric33,
 )
 from .softness import soft_coefficients
 
@@ -555,17 +556,6 @@ def _time_of_touch(s, u_half, g_n, h):
 
 
 @inline
-def _turned(inv_inertia, turn):
-    """``R A Rᵀ`` for the rotation ``R`` of the unit quaternion ``turn`` and a row-major 3 x 3 ``A``: the world inverse
-    inertia of a body once it is turned by ``turn`` (world frame)."""
-    r = quat_to_mat33(turn)
-    r0, r1, r2 = (r[0], r[1], r[2]), (r[3], r[4], r[5]), (r[6], r[7], r[8])
-    c0, c1, c2 = mat_vec(inv_inertia, r0), mat_vec(inv_inertia, r1), mat_vec(inv_inertia, r2)  # A Rᵀ, by columns
-    return (dot(r0, c0), dot(r0, c1), dot(r0, c2), dot(r1, c0), dot(r1, c1), dot(r1, c2), dot(r2, c0), dot(r2, c1),
-            dot(r2, c2))  # fmt: skip
-
-
-@inline
 def _move_back(i, dv, tau, turn, inv_inertia, inv_mass, pos, quat, inv_inertia_world):
     """Undo ``τ`` of body ``i``'s motion with a velocity change ``dv`` it got at ``τ`` into the substep, and turn it by
     ``turn``; ``inv_inertia`` is its world inverse inertia before the turn."""
@@ -574,9 +564,7 @@ def _move_back(i, dv, tau, turn, inv_inertia, inv_mass, pos, quat, inv_inertia_w
     store3(pos, i, add_scaled(load3(pos, i), dv, -tau))
     q = quat_normalize(quat_mul(turn, (quat[i, 0], quat[i, 1], quat[i, 2], quat[i, 3])))
     quat[i, 0], quat[i, 1], quat[i, 2], quat[i, 3] = q[0], q[1], q[2], q[3]
-    turned = _turned(inv_inertia, turn)
-    for k in range(9):
-        inv_inertia_world[i, k // 3, k % 3] = turned[k]
+    store33(inv_inertia_world, i, turned_symmetric33(turn, inv_inertia))
 
 
 @inline
@@ -596,9 +584,10 @@ def _energy_safe_share(rows, m, n, impulse, u_surface, arm_a, arm_b, va, wa, vb,
     The energy is that of the end of the substep, with semi-implicit Euler's velocity taken at the time of the
     positions (``v + a h/2``, which free flight under constant loads conserves exactly). Impulses ``λ`` at the points
     change the kinetic energy by ``½ Σ λ (vn⁻ + vn⁺)`` exactly (``v⁺ = v⁻ + W λ``); the bounce at ``τ`` (the body
-    moved back by ``τ Δv``) adds ``−g_n (τ − h/2) Σ λ`` through the loads. The two cancel for Newton's law at one
-    point, but the touch is timed with the loads alone, and a spinning body's points curve (a box at 40 rad/s: 30 g at
-    its corners): a box bouncing on its corners with e = 1 gained 2e-4 of its energy. Scaling all the impulses by
+    moved back by ``τ Δv``) adds ``−g_n (τ − h/2) Σ λ`` through the loads. For e = 1 the two cancel exactly at every
+    point the solve drives to its target, so the cap binds only where projected Gauss–Seidel stops short of
+    convergence (``IMPACT_BLOCK_SWEEPS``); it never did in the energy grid of
+    ``tests/analytic/test_contact_rates.py``, but it is what bounds such a bounce. Scaling all the impulses by
     ``s`` makes the change ``A s + B s²`` (``B = ½ λᵀ W λ > 0``): the largest ``s ≤ 1`` with no gain is ``−A / B``,
     Stronge's energetic bound on the impulse (W. J. Stronge, *Impact Mechanics*, 2000, ch. 4) taken as a cap."""
     linear, quadratic, total = 0.0, 0.0, 0.0
@@ -675,7 +664,8 @@ def resolve_impacts(rows, count, inv_mass, inv_inertia_world, pos, quat, pos0, q
             # gained 1.6 % of its energy at a bounce (issue 50).
             turn_a, turn_b = quat_exp(wa, tau), quat_exp(wb, tau)
             ia_start, ib_start = ia, ib
-            ia, ib = _turned(ia_start, turn_a), _turned(ib_start, turn_b)
+            ia = turned_symmetric33(turn_a, ia_start)
+            ib = turned_symmetric33(turn_b, ib_start)
             # The points that touch at τ (to round-off) bounce together, at their arms of time τ (reaching one point,
             # as in _arms_now): λ ≥ 0 with vn → −u_half + (1 + e) u_s, by projected Gauss-Seidel.
             relative = scale(sub(vb, va), tau)

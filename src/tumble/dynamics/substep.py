@@ -18,10 +18,11 @@ from ..math3d import (
     quat_integrate,
     quat_rotate,
     quat_rotate_inv,
-    quat_to_mat33,
     scale,
     store3,
     store4,
+    store33,
+    turned_symmetric33,
     world_inertia_apply,
 )
 from .actuation import actuator_wrench
@@ -45,18 +46,9 @@ def to_angular_velocity(bodies, quat, angmom, angvel, inv_inertia_world):
 
 @inline
 def _store_world_inverse_inertia(bodies, quat, i, inv_inertia_world):
-    """Body ``i``'s ``R I⁻¹ Rᵀ`` at its orientation now (``I⁻¹`` symmetric: the upper triangle, mirrored)."""
-    r = quat_to_mat33(load4(quat, i))
-    a = load33(bodies.inv_inertia_local, i)
-    for row in range(3):
-        # Row ``row`` of R A, then its products with the rows of R (the columns of Rᵀ) from the diagonal on.
-        x = r[3 * row] * a[0] + r[3 * row + 1] * a[3] + r[3 * row + 2] * a[6]
-        y = r[3 * row] * a[1] + r[3 * row + 1] * a[4] + r[3 * row + 2] * a[7]
-        z = r[3 * row] * a[2] + r[3 * row + 1] * a[5] + r[3 * row + 2] * a[8]
-        for column in range(row, 3):
-            value = x * r[3 * column] + y * r[3 * column + 1] + z * r[3 * column + 2]
-            inv_inertia_world[i, row, column] = value
-            inv_inertia_world[i, column, row] = value
+    """Body ``i``'s ``R I⁻¹ Rᵀ`` at its orientation now."""
+    turned = turned_symmetric33(load4(quat, i), load33(bodies.inv_inertia_local, i))
+    store33(inv_inertia_world, i, turned)
 
 
 @inline(counted=False)
