@@ -243,10 +243,7 @@ def quat_to_mat33(q):
 @inline
 def turned_symmetric33(q, a):
     """``R A Rᵀ`` for the rotation ``R`` of the unit quaternion ``q`` and a symmetric ``A`` (a row-major 9-tuple): an
-    inertia, or its inverse, carried from one frame to another. The upper triangle, mirrored (about 90 flops); an
-    isotropic ``A`` (a sphere's, a cube's) is its own turn, and is returned as it is, without ``R``."""
-    if a[1] == 0.0 and a[2] == 0.0 and a[5] == 0.0 and a[0] == a[4] and a[0] == a[8]:
-        return a
+    inertia, or its inverse, carried from one frame to another. The upper triangle, mirrored (about 90 flops)."""
     r = quat_to_mat33(q)
     # The rows of R A, then their products with the rows of R (the columns of Rᵀ) from the diagonal on.
     x0 = r[0] * a[0] + r[1] * a[3] + r[2] * a[6]
